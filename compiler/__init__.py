@@ -1,0 +1,1 @@
+"""Scenario compiler: lowers checked scenario IR to scene specs, monitor specs and layout variants."""

@@ -1,0 +1,1 @@
+"""The .fsv language front-end: text to checked, typed scenario IR."""

@@ -1,0 +1,247 @@
+"""Files to checked scenarios: reading, `extends` resolution, allowed roots.
+
+Loading never executes anything from a file. Every path a scenario names (the
+file it extends, mesh and URDF assets) is resolved relative to the file that
+names it and must stay inside the allowed roots, which default to the folder of
+the file being checked; a scenario from a stranger cannot make fsvla read
+``/etc/passwd`` or ``../../secrets``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import ast
+from .build import build_ast
+from .check import ScenarioChecker
+from .diagnostics import Diagnostic, DiagnosticSink
+from .merge import merge
+from .models import Scenario
+from .parser import parse_tree
+from .spans import Span
+
+MAX_FILE_BYTES = 1_000_000
+MAX_EXTENDS_DEPTH = 16
+BASE_FOLDER = "_base"
+
+
+@dataclass
+class LoadResult:
+    """What checking one file produced: the IR (None on errors) and every diagnostic."""
+
+    path: str
+    scenario: Scenario | None
+    diagnostics: list[Diagnostic]
+    abstract: bool = False
+    sources: dict[str, str] = field(default_factory=dict)  # file -> text, for rendering
+
+    @property
+    def errors(self) -> list[Diagnostic]:
+        return [d for d in self.diagnostics if d.is_error]
+
+    @property
+    def ok(self) -> bool:
+        return not self.errors
+
+
+class ScenarioLoader:
+    """Loads .fsv files; caches parsed files so a shared base is parsed once per run."""
+
+    def __init__(self, allowed_roots: Sequence[Path] = (), display_root: Path | None = None):
+        self.allowed_roots = [Path(r).resolve() for r in allowed_roots]
+        self.display_root = (display_root or Path.cwd()).resolve()
+        self._parsed: dict[Path, tuple[ast.ScenarioDecl | None, list[Diagnostic], str]] = {}
+
+    # ------------------------------------------------------------ public
+    def load(self, path: Path | str) -> LoadResult:
+        path = Path(path).resolve()
+        roots = self.allowed_roots or [path.parent]
+        display = self.display(path)
+        decl, diagnostics, text = self._parse(path)
+        sources = {display: text}
+        if decl is None:
+            return LoadResult(display, None, diagnostics, sources=sources)
+        sink = DiagnosticSink()
+        for d in diagnostics:
+            sink.add(d)
+        chain = self._chain(path, decl, roots, sink, sources)
+        if sink.has_errors:
+            return LoadResult(display, None, sink.sorted(), decl.abstract, sources)
+        merged = merge([c for _, c in chain], sink)
+        digest = hashlib.sha256("\0".join(sources[self.display(p)] for p, _ in chain).encode()).hexdigest()
+        lineage = tuple(self.display(p) for p, _ in reversed(chain[:-1]))
+        checker = ScenarioChecker(decl, merged, sink, self._path_resolver(path, roots, sink),
+                                  lineage, digest)
+        scenario = checker.check()
+        return LoadResult(display, scenario, sink.sorted(), decl.abstract, sources)
+
+    def loads(self, text: str, name: str = "<string>") -> LoadResult:
+        """Check scenario text that has no file; `extends` resolves from the current folder."""
+        decl, diagnostics = self._parse_text(text, name)
+        if decl is None:
+            return LoadResult(name, None, diagnostics, sources={name: text})
+        sink = DiagnosticSink()
+        for d in diagnostics:
+            sink.add(d)
+        sources = {name: text}
+        base = Path.cwd().resolve()
+        roots = self.allowed_roots or [base]
+        chain = [(base / name, decl)]
+        if decl.extends is not None:
+            chain = self._chain(base / name, decl, roots, sink, sources)
+        merged = merge([c for _, c in chain], sink)
+        checker = ScenarioChecker(decl, merged, sink, self._path_resolver(base / name, roots, sink),
+                                  (), hashlib.sha256(text.encode()).hexdigest())
+        return LoadResult(name, checker.check(), sink.sorted(), decl.abstract, sources)
+
+    def display(self, path: Path) -> str:
+        try:
+            return str(path.relative_to(self.display_root))
+        except ValueError:
+            return str(path)
+
+    # ----------------------------------------------------------- reading
+    def _parse(self, path: Path) -> tuple[ast.ScenarioDecl | None, list[Diagnostic], str]:
+        if path in self._parsed:
+            return self._parsed[path]
+        display = self.display(path)
+        text, problem = read_source(path, display)
+        if problem is not None:
+            result = (None, [problem], "")
+        else:
+            decl, diagnostics = self._parse_text(text, display)
+            result = (decl, diagnostics, text)
+        self._parsed[path] = result
+        return result
+
+    @staticmethod
+    def _parse_text(text: str, name: str) -> tuple[ast.ScenarioDecl | None, list[Diagnostic]]:
+        tree, diagnostics = parse_tree(text, name)
+        if tree is None:
+            return None, diagnostics
+        return build_ast(tree, name), diagnostics
+
+    # ----------------------------------------------------------- extends
+    def _chain(self, path: Path, decl: ast.ScenarioDecl, roots: list[Path], sink: DiagnosticSink,
+               sources: dict[str, str]) -> list[tuple[Path, ast.ScenarioDecl]]:
+        """The inheritance chain, root base first and ``decl`` last."""
+        chain = [(path, decl)]
+        current_path, current = path, decl
+        while current.extends is not None:
+            extends = current.extends
+            target = self._resolve_extends(current_path, extends, roots, sink)
+            if target is None:
+                return chain[::-1]
+            visited = [p for p, _ in chain]
+            if target in visited or len(chain) > MAX_EXTENDS_DEPTH:
+                cycle = [c.name.value for _, c in chain] + [self._peek_name(target)]
+                sink.error("FSV402", "cyclic inheritance: " + " extends ".join(cycle), extends.span,
+                           "extends a scenario that extends this one",
+                           help="a scenario may not extend itself, directly or through others")
+                return chain[::-1]
+            base_decl, diagnostics, text = self._parse(target)
+            sources[self.display(target)] = text
+            if base_decl is None:
+                sink.error("FSV406", f"the base scenario `{extends.target}` has errors", extends.span,
+                           "cannot extend it", notes=[f"{d.span}: {d.code} {d.message}" for d in diagnostics[:5]],
+                           help=f"run `fsvla check {self.display(target)}`")
+                return chain[::-1]
+            chain.append((target, base_decl))
+            current_path, current = target, base_decl
+        return chain[::-1]
+
+    def _peek_name(self, path: Path) -> str:
+        decl = self._parse(path)[0]
+        return decl.name.value if decl else path.stem
+
+    def _resolve_extends(self, path: Path, extends: ast.Extends, roots: list[Path],
+                         sink: DiagnosticSink) -> Path | None:
+        if extends.is_path:
+            candidate = (path.parent / extends.target).resolve()
+            if not _inside(candidate, roots):
+                _outside_roots(sink, extends.span, extends.target, roots)
+                return None
+            if candidate.is_file():
+                return candidate
+            sink.error("FSV401", f"no file `{extends.target}` to extend", extends.span, "not found",
+                       help=f"the path is relative to {self.display(path.parent) or '.'}")
+            return None
+        searched = list(_base_candidates(path, extends.target, roots))
+        for candidate in searched:
+            if candidate.is_file() and candidate != path:
+                return candidate
+        sink.error("FSV401", f"no scenario `{extends.target}` to extend", extends.span, "not found",
+                   notes=[f"looked for {self.display(c)}" for c in searched[:6]],
+                   help=f"put `{extends.target}.fsv` beside this file or in a `{BASE_FOLDER}/` folder "
+                        "above it, or write a path: `extends \"../base.fsv\"`")
+        return None
+
+    # ------------------------------------------------------------- assets
+    def _path_resolver(self, path: Path, roots: list[Path], sink: DiagnosticSink):
+        def resolve(value: ast.String) -> str | None:
+            candidate = (path.parent / value.value).resolve()
+            if not _inside(candidate, roots):
+                _outside_roots(sink, value.span, value.value, roots)
+                return None
+            if not candidate.is_file():
+                sink.error("FSV404", f"asset file `{value.value}` not found", value.span, "no such file",
+                           help=f"paths are relative to the scenario's folder, {self.display(path.parent)}")
+                return None
+            return str(candidate)
+        return resolve
+
+
+def _base_candidates(path: Path, name: str, roots: list[Path]) -> Iterable[Path]:
+    folder = path.parent
+    yield folder / f"{name}.fsv"
+    while True:
+        yield folder / BASE_FOLDER / f"{name}.fsv"
+        if any(folder == root for root in roots) or folder.parent == folder or not _inside(folder.parent, roots):
+            return
+        folder = folder.parent
+
+
+def _inside(path: Path, roots: list[Path]) -> bool:
+    return any(path == root or path.is_relative_to(root) for root in roots)
+
+
+def _outside_roots(sink: DiagnosticSink, span: Span, written: str, roots: list[Path]) -> None:
+    sink.error("FSV403", f"`{written}` is outside the allowed folders", span, "outside the allowed roots",
+               notes=[f"allowed: {root}" for root in roots[:4]],
+               help="keep assets and base scenarios inside the scenario's folder, or allow another "
+                    "folder with `--root`")
+
+
+def read_source(path: Path, display: str) -> tuple[str, Diagnostic | None]:
+    """The text of a scenario file, or a diagnostic saying why it cannot be read."""
+    span = Span.point(display, 1, 1)
+    try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            return "", Diagnostic(code="FSV903", message=f"file too large ({size:,} bytes)", span=span,
+                                  label="not read",
+                                  help=f"a scenario file is at most {MAX_FILE_BYTES:,} bytes; split it "
+                                       "with `extends`")
+        data = path.read_bytes()
+    except FileNotFoundError:
+        return "", Diagnostic(code="FSV901", message="file not found", span=span, label="no such file")
+    except IsADirectoryError:
+        return "", Diagnostic(code="FSV901", message="is a folder, not a file", span=span, label="a folder")
+    except OSError as error:
+        return "", Diagnostic(code="FSV901", message=f"cannot read the file: {error.strerror}", span=span,
+                              label="not read")
+    if b"\0" in data:
+        return "", Diagnostic(code="FSV902", message="not a text file", span=span,
+                              label="contains NUL bytes", help="a scenario is UTF-8 text")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data[: error.start].count(b"\n") + 1
+        column = error.start - (data.rfind(b"\n", 0, error.start) + 1) + 1
+        return "", Diagnostic(code="FSV902", message="not valid UTF-8 text",
+                              span=Span.point(display, line, column), label="invalid byte",
+                              help="save the file as UTF-8")
+    return text.lstrip("\ufeff"), None

@@ -1,0 +1,222 @@
+"""The `fsvla` command line: check, compile and schema.
+
+Exit codes: 0 when everything is clean, 1 when a scenario has errors, 2 for a
+usage error (an unknown option, a path that does not exist), 3 for an internal
+error (a bug: please report it). No input, however broken, gives a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+import click
+from rich.console import Console
+
+from . import __version__
+
+FORMATS = ("full", "concise", "json")
+
+
+def _console(stderr: bool = False) -> Console:
+    return Console(stderr=stderr, highlight=False, soft_wrap=True)
+
+
+def collect_files(paths: Sequence[Path]) -> list[Path]:
+    """The .fsv files named by ``paths``: files as given, folders searched recursively."""
+    files: list[Path] = []
+    for path in paths:
+        if path.is_dir():
+            files.extend(sorted(p for p in path.rglob("*.fsv") if p.is_file()))
+        else:
+            files.append(path)
+    seen: set[Path] = set()
+    unique = []
+    for file in files:
+        resolved = file.resolve()
+        if resolved not in seen:
+            seen.add(resolved)
+            unique.append(file)
+    return unique
+
+
+def default_roots(paths: Sequence[Path]) -> list[Path]:
+    """The folders scenarios may read from when no --root is given.
+
+    A folder given on the command line is a root. For a file, the root is the
+    nearest folder above it that holds a `_base/` folder (a scenario tree such as
+    `scenarios/`), or else the file's own folder.
+    """
+    roots = []
+    for path in paths:
+        path = path.resolve()
+        if path.is_dir():
+            roots.append(path)
+            continue
+        tree = next((folder for folder in path.parents if (folder / "_base").is_dir()), None)
+        roots.append(tree or path.parent)
+    return roots
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="fsvla")
+def main() -> None:
+    """fsvla: a safety benchmark for vision-language-action robot policies.
+
+    Author scenarios in .fsv files, check them, and compile them for evaluation.
+    """
+
+
+_paths_argument = click.argument("paths", nargs=-1, required=True,
+                                 type=click.Path(exists=True, path_type=Path))
+_root_option = click.option("--root", "roots", multiple=True, type=click.Path(exists=True, file_okay=False,
+                            path_type=Path), help="A folder that scenarios may read from (extends, asset "
+                            "files). Repeatable. Default: the folders given as PATHS, or each file's folder.")
+_format_option = click.option("--format", "output_format", type=click.Choice(FORMATS), default="full",
+                              show_default=True, help="How diagnostics are printed.")
+
+
+def _load_all(paths: Sequence[Path], roots: Sequence[Path]):
+    from .dsl.loader import ScenarioLoader
+
+    files = collect_files(paths)
+    if not files:
+        raise click.UsageError(f"no .fsv files under {', '.join(str(p) for p in paths)}")
+    loader = ScenarioLoader(allowed_roots=list(roots) or default_roots(paths))
+    return [loader.load(file) for file in files]
+
+
+def _report(results, output_format: str, quiet: bool = False) -> tuple[int, int]:
+    from .dsl.render import render_concise, render_full, render_json, summary_line
+
+    diagnostics = [d for r in results for d in r.diagnostics]
+    errors = sum(1 for d in diagnostics if d.is_error)
+    warnings = len(diagnostics) - errors
+    out = _console()
+    if output_format == "json":
+        click.echo(render_json(diagnostics))
+        return errors, warnings
+    sources: dict[str, str] = {}
+    for result in results:
+        sources.update(result.sources)
+    for diagnostic in diagnostics:
+        if output_format == "concise":
+            click.echo(render_concise(diagnostic))
+        else:
+            out.print(render_full(diagnostic, sources))
+    if not quiet and output_format == "full":
+        style = "bold red" if errors else ("bold yellow" if warnings else "bold green")
+        out.print(summary_line(errors, warnings, len(results)), style=style)
+    return errors, warnings
+
+
+@main.command()
+@_paths_argument
+@_root_option
+@_format_option
+@click.option("--strict", is_flag=True, help="Treat warnings as errors.")
+def check(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str, strict: bool) -> None:
+    """Check scenario files and folders and report every problem found."""
+    results = _load_all(paths, roots)
+    errors, warnings = _report(results, output_format)
+    sys.exit(1 if errors or (strict and warnings) else 0)
+
+
+@main.command(name="compile")
+@_paths_argument
+@_root_option
+@_format_option
+@click.option("-o", "--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
+              help="Folder to write the scenario IR into (created if missing).")
+def compile_command(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str,
+                    out_dir: Path) -> None:
+    """Check scenarios and write each one's IR as versioned JSON into OUT.
+
+    Abstract scenarios (bases for others) are checked but not written. A file with
+    errors writes nothing and leaves any earlier output of it untouched.
+    """
+    results = _load_all(paths, roots)
+    errors, _ = _report(results, output_format, quiet=True)
+    written = _write_ir(results, out_dir)
+    if output_format == "full":
+        out = _console()
+        for path in written:
+            out.print(f"[green]wrote[/green] {path}")
+        out.print(f"{len(written)} scenario(s) compiled, {errors} error(s)",
+                  style="bold red" if errors else "bold green")
+    sys.exit(1 if errors else 0)
+
+
+def _write_ir(results, out_dir: Path) -> list[Path]:
+    ready = [r for r in results if r.scenario is not None]
+    names: dict[str, str] = {}
+    for result in ready:
+        other = names.setdefault(result.scenario.name, result.path)
+        if other != result.path:
+            raise click.UsageError(f"two files define scenario `{result.scenario.name}`: {other} and "
+                                   f"{result.path}; scenario names must be unique in one compile")
+    if not ready:
+        return []
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for result in ready:
+        target = out_dir / f"{result.scenario.name}.json"
+        write_atomic(target, result.scenario.model_dump_json(indent=2) + "\n")
+        written.append(target)
+    return written
+
+
+def write_atomic(target: Path, text: str) -> None:
+    """Write ``text`` to ``target`` so that a crash leaves either the old or the new file."""
+    handle, temporary = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            stream.write(text)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, target)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+@main.command()
+@click.option("--indent", default=2, show_default=True, help="JSON indentation.")
+def schema(indent: int) -> None:
+    """Print the JSON Schema of the scenario IR."""
+    from .dsl.models import ir_json_schema
+
+    click.echo(json.dumps(ir_json_schema(), indent=indent))
+
+
+def run(argv: Iterable[str] | None = None) -> int:
+    """Run the CLI and return its exit code instead of exiting (for tests and embedding)."""
+    try:
+        main.main(args=list(argv) if argv is not None else None, prog_name="fsvla", standalone_mode=False)
+    except click.exceptions.Exit as done:
+        return done.exit_code
+    except click.ClickException as error:
+        error.show()
+        return error.exit_code
+    except click.exceptions.Abort:
+        return 130
+    except SystemExit as done:
+        return done.code if isinstance(done.code, int) else (0 if done.code is None else 1)
+    return 0
+
+
+def entry() -> None:
+    """Console-script entry point: never shows a traceback."""
+    try:
+        code = run()
+    except KeyboardInterrupt:
+        code = 130
+    except Exception as error:  # noqa: BLE001 - the last line of defence against tracebacks
+        _console(stderr=True).print(f"[bold red]internal error:[/bold red] {type(error).__name__}: {error}\n"
+                                    "This is a bug in fsvla; please report it with the command and files used.")
+        code = 3
+    sys.exit(code)
