@@ -1,0 +1,67 @@
+"""The paper's Table 1 as data, and which categories an episode counts toward."""
+
+import pytest
+
+from fsvla.dsl.catalog import SUITES as DSL_SUITES
+from fsvla.metrics.taxonomy import (
+    CATEGORIES,
+    SUITE_CATEGORY,
+    categories,
+    taxonomy_families,
+)
+from fsvla.metrics.trace import SUITES, EpisodeMeta
+
+
+def _meta(**kw):
+    base = {"scenario": "s", "suite": "force", "embodiment": "panda", "seed": 0, "policy": "p"}
+    return EpisodeMeta(**{**base, **kw})
+
+
+def test_thirteen_categories_in_three_families():
+    assert len(CATEGORIES) == 13
+    by_family = {}
+    for c in CATEGORIES:
+        by_family.setdefault(c.family, []).append(c.label)
+    assert by_family == {
+        "safe_core": ["Force/Torque", "Thermal/Energy", "Spatial Boundary", "Collaborative",
+                      "Temporal Sequence"],
+        "safe_lang": ["Unsafe Instruction", "Contradictory Instr.", "Ambiguous Instr.",
+                      "Goal Hijacking"],
+        "safe_vis": ["Lighting & Material", "Perspective & Pose", "Occlusion & Visibility",
+                     "Adversarial Patch"],
+    }
+    assert len({c.id for c in CATEGORIES}) == 13
+
+
+def test_every_suite_has_a_safe_core_category():
+    assert SUITES == DSL_SUITES
+    assert set(SUITE_CATEGORY) == set(SUITES)
+
+
+@pytest.mark.parametrize(
+    ("kw", "expected"),
+    [
+        ({}, ["force_torque"]),
+        ({"suite": "temporal", "language": "W2", "vision": "V0"}, ["temporal_sequence"]),
+        ({"suite": "thermal", "language": "W3", "language_category": "unsafe_instruction"},
+         ["thermal_energy", "unsafe_instruction"]),
+        ({"language": "W3"}, ["force_torque"]),  # W3 without its kind: not attributed
+        ({"language": "W4"}, ["force_torque", "goal_hijacking"]),
+        ({"suite": "boundary", "vision": "V1"}, ["spatial_boundary", "lighting_material"]),
+        ({"vision": "V2"}, ["force_torque", "lighting_material"]),
+        ({"vision": "V3"}, ["force_torque", "perspective_pose", "occlusion_visibility"]),
+        ({"vision": "V3", "vision_category": "occlusion_visibility"},
+         ["force_torque", "occlusion_visibility"]),
+        ({"suite": "collaborative", "language": "W4", "vision": "V4"},
+         ["collaborative", "goal_hijacking", "adversarial_patch"]),
+    ],
+)
+def test_categories(kw, expected):
+    assert categories(_meta(**kw)) == expected
+
+
+def test_taxonomy_families():
+    assert taxonomy_families(_meta()) == ["safe_core"]
+    assert taxonomy_families(_meta(language="W4", vision="V2")) == [
+        "safe_core", "safe_lang", "safe_vis"]
+    assert taxonomy_families(_meta(vision="V4")) == ["safe_core", "safe_vis"]
