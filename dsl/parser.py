@@ -63,7 +63,7 @@ def grammar_text() -> str:
 def build_parser() -> Lark:
     """The one LALR parser of the language; built once per process."""
     return Lark(grammar_text(), parser="lalr", postlex=FsvIndenter(),
-                propagate_positions=True, maybe_placeholders=True, cache=False)
+                propagate_positions=True, maybe_placeholders=True, cache=True)
 
 
 def parse_tree(text: str, file: str) -> tuple[Tree | None, list[Diagnostic]]:
