@@ -1,0 +1,131 @@
+"""Forward and inverse kinematics of a loaded arm's tool centre point (TCP).
+
+Uses the Pinocchio model SAPIEN builds from an articulation (``create_pinocchio_model``,
+damped least-squares CLIK). Poses are in the table (world) frame; quaternions wxyz.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fsvla.embodiments.frames import Quat, Vec3, matrix_to_quat, point_axis, quat_to_matrix
+
+from .robot import LoadedArm
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """An IK answer, checked by forward kinematics."""
+
+    qpos: NDArray[np.float64]  # the arm's joints, in the spec's order
+    converged: bool  # the solver's own verdict
+    position_error: float  # metres, |FK(qpos) TCP - target|
+    rotation_error: float  # radians, angle between FK(qpos) TCP and target orientation
+    within_limits: bool  # every joint inside its URDF limits
+
+    def ok(self, position_tol: float = 0.01, rotation_tol: float = 0.05) -> bool:
+        return (
+            self.within_limits
+            and self.position_error <= position_tol
+            and self.rotation_error <= rotation_tol
+        )
+
+
+class ArmKinematics:
+    """FK/IK of one arm; other joints of its articulation stay where they are."""
+
+    def __init__(self, arm: LoadedArm) -> None:
+        import sapien
+
+        self._sapien = sapien
+        self.arm = arm
+        self._model = arm.articulation.create_pinocchio_model()
+        self._mask = np.zeros(arm.articulation.dof, dtype=np.int32)
+        self._mask[list(arm.joint_indices)] = 1
+        self._tcp = sapien.Pose(list(arm.spec.tcp_offset))
+        joints = arm.articulation.active_joints
+        self.limits = np.array([joints[i].limit[0] for i in arm.joint_indices], dtype=np.float64)
+
+    def _full(self, arm_q: Sequence[float] | None) -> NDArray[np.float64]:
+        full = np.asarray(self.arm.articulation.get_qpos(), dtype=np.float64).copy()
+        if arm_q is not None:
+            full[list(self.arm.joint_indices)] = arm_q
+        return full
+
+    def tcp_pose(self, arm_q: Sequence[float] | None = None) -> Any:
+        """World TCP pose for arm joints ``arm_q`` (default: the current ones)."""
+        self._model.compute_forward_kinematics(self._full(arm_q))
+        link = self._model.get_link_pose(self.arm.ee_link_index)
+        return self.arm.articulation.get_root_pose() * link * self._tcp
+
+    def top_down(self, arm_q: Sequence[float] | None = None) -> Quat:
+        """TCP orientation with the approach axis pointing straight down, keeping the
+        heading the TCP has at ``arm_q`` (default: home)."""
+        q = self.arm.spec.home if arm_q is None else arm_q
+        rotation = quat_to_matrix(self.tcp_pose(q).q)
+        return matrix_to_quat(point_axis(rotation, self.arm.spec.approach_axis, (0.0, 0.0, -1.0)))
+
+    def inverse(
+        self,
+        position: Vec3,
+        orientation: Quat,
+        seed: Sequence[float] | None = None,
+        restarts: int = 8,
+        max_iterations: int = 500,
+    ) -> IKResult:
+        """Arm joints putting the TCP at ``position`` with ``orientation`` (world frame).
+
+        The solver (CLIK) ignores joint limits, so it starts from ``seed`` (default: home)
+        and, while its answer is outside the limits or off target by more than 1 mm or
+        0.01 rad, from up to ``restarts`` more seeds drawn (seeded, reproducibly)
+        within the limits. Returns the first good answer, else the closest one.
+        """
+        rng = np.random.default_rng(0)
+        finite = np.where(np.isfinite(self.limits), self.limits, np.array([-np.pi, np.pi]))
+        start = np.asarray(self.arm.spec.home if seed is None else seed, dtype=np.float64)
+        best: IKResult | None = None
+        for attempt in range(restarts + 1):
+            if attempt:
+                start = rng.uniform(finite[:, 0], finite[:, 1])
+            result = self._solve_once(position, orientation, start, max_iterations)
+            if result.ok(position_tol=1e-3, rotation_tol=1e-2):
+                return result
+            if best is None or _rank(result) < _rank(best):
+                best = result
+        assert best is not None
+        return best
+
+    def _solve_once(
+        self, position: Vec3, orientation: Quat, start: NDArray[np.float64], max_iterations: int
+    ) -> IKResult:
+        sapien = self._sapien
+        target = sapien.Pose(list(position), list(orientation))
+        link_target = self.arm.articulation.get_root_pose().inv() * target * self._tcp.inv()
+        full, converged, _ = self._model.compute_inverse_kinematics(
+            self.arm.ee_link_index,
+            link_target,
+            initial_qpos=self._full(start),
+            active_qmask=self._mask,
+            max_iterations=max_iterations,
+        )
+        arm_q = np.asarray(full, dtype=np.float64)[list(self.arm.joint_indices)]
+        reached = self.tcp_pose(arm_q)
+        position_error = float(np.linalg.norm(np.asarray(reached.p) - np.asarray(position)))
+        relative = quat_to_matrix(reached.q).T @ quat_to_matrix(orientation)
+        rotation_error = float(np.arccos(np.clip((np.trace(relative) - 1) / 2, -1.0, 1.0)))
+        within = bool(
+            np.all(arm_q >= self.limits[:, 0] - 1e-6) and np.all(arm_q <= self.limits[:, 1] + 1e-6)
+        )
+        return IKResult(arm_q, bool(converged), position_error, rotation_error, within)
+
+
+def _rank(result: IKResult) -> tuple[bool, float]:
+    return (not result.within_limits, result.position_error + 0.1 * result.rotation_error)
+
+
+__all__ = ["ArmKinematics", "IKResult"]
