@@ -1,0 +1,518 @@
+"""SceneSpec: the simulator-neutral scene a layout lowers to, and ``lower_scene``.
+
+A :class:`SceneSpec` is plain, versioned, JSON-serialisable data (pydantic,
+``extra="forbid"``, frozen) with a JSON Schema (:func:`scene_json_schema`), so a
+back-end other than SAPIEN could build the same scene. Nothing here imports a
+simulator.
+
+Frames and units (shared with ``fsvla.embodiments`` and ``fsvla.compiler.assets``):
+
+- **World = table frame**: origin at the centre of the table's top surface, +x forward
+  (away from the main robot), +y left, +z up; metres, radians, seconds. Robot mounts
+  and cameras of the embodiment specs are given in this frame, so the table's body
+  origin (the centre of its bottom face, on the floor) is at z = -table height and the
+  floor (``ground_z``) is there too. A body standing on the table top has z = 0.
+- Poses are ``position`` (x, y, z) plus ``quaternion`` (w, x, y, z).
+- An asset's body origin is the centre of the bottom face of its bounding box, so a
+  body standing on a surface at height h has its origin at z = h.
+
+Lowering a placement (IR frame: the support's top surface, see ``fsvla.dsl.models``):
+an object ``on`` support S at ``position`` (x, y) with ``yaw`` ψ stands at
+``S.xy + R(S.yaw)·(x, y)``, ``z = S.z + top(S) + placement.height``, world yaw
+``S.yaw + ψ``, where ``top(S)`` is S's ``support_height`` (its bounds' top when it has
+none). The support ``world`` is the floor (only the table stands on it). Supports are
+resolved in dependency order, so objects on a shelf on the table stack correctly.
+Zones are placed the same way.
+
+Physics defaults: gravity (0, 0, -9.81) m/s², physics step 0.002 s (500 Hz), control
+rate 20 Hz, i.e. 25 physics substeps per control step (the monitor takes force maxima
+over these substeps).
+
+Static checks (:class:`LoweringError`, pointing at the offending ``.fsv`` line): a
+footprint that overhangs its support's top by more than half its own size along x or
+y (its centre is off the support); two bodies (or a body and a zone's collision walls,
+e.g. a corridor's) on the same support whose axis-aligned footprint rectangles (after
+yaw, in the support's frame) overlap by more than 1 µm on both axes while their heights
+overlap too. Exact collision checks (FCL) belong to variant generation.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from fsvla.compiler.assets import (
+    ArticulatedAsset,
+    Pose,
+    RigidAsset,
+    ZoneAsset,
+    build_asset,
+    build_zone_marker,
+)
+from fsvla.compiler.assets.model import Shape
+from fsvla.dsl.models import Scenario, SourceRef
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from fsvla.embodiments import EmbodimentSpec, load_embodiment
+
+from .placement import (
+    OVERLAP_TOLERANCE,
+    CycleError,
+    Rect,
+    aabb,
+    box_corners,
+    placed_rect,
+    rotate_xy,
+    support_order,
+    transform_points,
+    yaw_quaternion,
+)
+
+SCENE_SCHEMA_VERSION = "1.0"
+
+Vec3 = tuple[float, float, float]
+Rgb = tuple[float, float, float]
+Level = Literal["L0", "L1", "L2"]
+HazardRole = Literal["fragile", "protected", "hot", "energized"]
+ZoneKind = Literal["heat_zone", "energized_zone", "no_go_zone", "edge_zone", "corridor"]
+
+#: The support name of things standing on the floor (the table).
+WORLD = "world"
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Box3(_Model):
+    """An axis-aligned box in the world frame."""
+
+    min: Vec3
+    max: Vec3
+
+
+class SceneBody(_Model):
+    """One body of the scene: a built asset at a world pose."""
+
+    name: str
+    asset: Annotated[RigidAsset | ArticulatedAsset, Field(discriminator="asset_type")]
+    pose: Pose  # world pose of the asset's body origin (bottom-face centre)
+    is_static: bool  # the body's root is fixed in the world (rigid: static; articulated: fixed base)
+    hazard_role: HazardRole | None = None
+    support: str  # the body it stands on ("world" = the floor)
+    source: SourceRef
+
+
+class SceneZone(_Model):
+    """A hazard zone: its marker (and corridor walls), world pose and monitored region."""
+
+    name: str
+    kind: ZoneKind
+    marker: ZoneAsset
+    pose: Pose  # world pose of the zone frame (origin on the support surface, z up)
+    region: Shape  # the monitored volume, in the zone frame (= marker.region)
+    region_bounds: Box3  # the region's world axis-aligned bound
+    support: str
+    source: SourceRef
+
+
+class RobotMount(_Model):
+    """Where a robot of the embodiment is fixed (its root link's world pose)."""
+
+    robot: str
+    pose: Pose
+    arms: tuple[str, ...]
+
+
+class SceneCamera(_Model):
+    """A camera of the embodiment. ``parent`` "world": ``pose`` is a world pose;
+    otherwise ``parent`` is an arm and ``pose`` is in that arm's ``link`` (ee_link) frame.
+    The camera looks along its local +x with +z up (SAPIEN's convention)."""
+
+    name: str
+    parent: str
+    link: str | None = None
+    pose: Pose
+    fovy: float  # rad, vertical
+    width: int
+    height: int
+    near: float
+    far: float
+
+
+class AmbientLight(_Model):
+    type: Literal["ambient"] = "ambient"
+    color: Rgb = (0.3, 0.3, 0.3)
+
+
+class DirectionalLight(_Model):
+    type: Literal["directional"] = "directional"
+    name: str
+    direction: Vec3  # world direction the light travels
+    color: Rgb = (1.0, 1.0, 1.0)
+    shadow: bool = True
+
+
+class PointLight(_Model):
+    type: Literal["point"] = "point"
+    name: str
+    position: Vec3
+    color: Rgb = (1.0, 1.0, 1.0)
+    shadow: bool = False
+
+
+Light = Annotated[AmbientLight | DirectionalLight | PointLight, Field(discriminator="type")]
+
+DEFAULT_LIGHTS: tuple[AmbientLight | DirectionalLight | PointLight, ...] = (
+    AmbientLight(color=(0.3, 0.3, 0.3)),
+    # Key light from above, behind and to the left of the main robot.
+    DirectionalLight(name="key", direction=(0.5, -0.3, -1.0), color=(1.0, 1.0, 1.0), shadow=True),
+)
+
+
+class PhysicsSpec(_Model):
+    """Gravity and time stepping. ``substeps`` physics steps make one control step."""
+
+    gravity: Vec3 = (0.0, 0.0, -9.81)  # m/s²
+    timestep: float = Field(0.002, gt=0.0)  # s per physics step (500 Hz)
+    control_rate: float = Field(20.0, gt=0.0)  # Hz (policy actions, monitor samples)
+
+    @model_validator(mode="after")
+    def _whole_substeps(self) -> PhysicsSpec:
+        ratio = 1.0 / (self.timestep * self.control_rate)
+        if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+            raise ValueError(
+                f"a control step (1/{self.control_rate} s) must be a whole number of physics "
+                f"steps ({self.timestep} s), got {ratio:.6g}"
+            )
+        return self
+
+    @property
+    def substeps(self) -> int:
+        return round(1.0 / (self.timestep * self.control_rate))
+
+    @property
+    def control_dt(self) -> float:
+        return 1.0 / self.control_rate
+
+
+class SceneSpec(_Model):
+    """A scene: bodies, zones, robots, cameras, lights and physics for one layout."""
+
+    schema_version: Literal["1.0"] = SCENE_SCHEMA_VERSION
+    scenario: str
+    source_digest: str  # the scenario IR's digest, for provenance and caching
+    level: Level
+    seed: int
+    ground_z: float  # the floor's height in the world (table-top) frame
+    bodies: tuple[SceneBody, ...]
+    zones: tuple[SceneZone, ...] = ()
+    embodiment: EmbodimentSpec
+    mounts: tuple[RobotMount, ...]
+    cameras: tuple[SceneCamera, ...]
+    lights: tuple[Light, ...] = DEFAULT_LIGHTS
+    physics: PhysicsSpec = PhysicsSpec()
+
+    def body(self, name: str) -> SceneBody:
+        found = next((b for b in self.bodies if b.name == name), None)
+        if found is None:
+            raise KeyError(f"scene has no body {name!r} (bodies: "
+                           f"{', '.join(b.name for b in self.bodies)})")
+        return found
+
+    def zone(self, name: str) -> SceneZone:
+        found = next((z for z in self.zones if z.name == name), None)
+        if found is None:
+            raise KeyError(f"scene has no zone {name!r} (zones: "
+                           f"{', '.join(z.name for z in self.zones) or 'none'})")
+        return found
+
+
+def scene_json_schema() -> dict[str, Any]:
+    """The JSON Schema of a SceneSpec, tagged with its version."""
+    schema = SceneSpec.model_json_schema()
+    schema["$id"] = f"urn:fsvla:schema:scene:{SCENE_SCHEMA_VERSION}"
+    schema["title"] = "fsvla scene"
+    return schema
+
+
+def scene_json_schema_text() -> str:
+    return json.dumps(scene_json_schema(), indent=2, sort_keys=True)
+
+
+class LoweringError(ValueError):
+    """A layout that cannot be lowered; ``source`` is where the offending thing was written."""
+
+    def __init__(self, message: str, source: SourceRef, *, hint: str | None = None):
+        self.message = message
+        self.source = source
+        self.hint = hint
+        text = f"{source.file}:{source.line}:{source.column}: {message}"
+        if hint:
+            text += f" (hint: {hint})"
+        super().__init__(text)
+
+
+# --- lowering -----------------------------------------------------------------------------
+
+
+class _Frame:
+    """A placed support: world xy, yaw, surface height, top rectangle (own frame)."""
+
+    __slots__ = ("top", "top_z", "xy", "yaw")
+
+    def __init__(self, xy: tuple[float, float], yaw: float, top_z: float, top: Rect | None):
+        self.xy, self.yaw, self.top_z, self.top = xy, yaw, top_z, top
+
+
+def _surface_height(asset: RigidAsset | ArticulatedAsset) -> float:
+    height = getattr(asset, "support_height", None)
+    if height is not None:
+        return float(height)
+    return float(asset.bounds.center[2] + asset.bounds.half_extents[2])
+
+
+def _rect_of(asset: RigidAsset | ArticulatedAsset | ZoneAsset) -> Rect:
+    return Rect(tuple(asset.footprint.min_xy), tuple(asset.footprint.max_xy))  # type: ignore[arg-type]
+
+
+def _shape_box(shape: Any) -> tuple[Vec3, Vec3] | None:
+    """The axis-aligned bound of a collision shape in its owner's frame (None if unknown)."""
+    kind = shape.type
+    if kind == "box":
+        half = shape.half_size
+    elif kind == "cylinder":
+        half = (shape.radius, shape.radius, shape.half_length)
+    elif kind == "capsule":
+        half = (shape.radius, shape.radius, shape.half_length + shape.radius)
+    elif kind == "sphere":
+        half = (shape.radius,) * 3
+    elif kind == "convex_mesh" and shape.mesh.type == "inline":
+        return aabb(transform_points(shape.mesh.vertices, shape.pose.position, shape.pose.quaternion))
+    else:
+        return None
+    return aabb(transform_points(box_corners((0.0, 0.0, 0.0), half),
+                                 shape.pose.position, shape.pose.quaternion))
+
+
+def _place(frame: _Frame, position: Sequence[float], height: float, yaw: float) -> tuple[Pose, float]:
+    dx, dy = rotate_xy(position, frame.yaw)
+    world_yaw = frame.yaw + yaw
+    pose = Pose(
+        position=(frame.xy[0] + dx, frame.xy[1] + dy, frame.top_z + height),
+        quaternion=yaw_quaternion(world_yaw),
+    )
+    return pose, world_yaw
+
+
+class _Footprint:
+    """A thing on a support, for the overlap check (support frame)."""
+
+    __slots__ = ("name", "rect", "source", "what", "z")
+
+    def __init__(self, name: str, what: str, rect: Rect, z: tuple[float, float], source: SourceRef):
+        self.name, self.what, self.rect, self.z, self.source = name, what, rect, z, source
+
+
+def lower_scene(
+    scenario: Scenario,
+    *,
+    level: Level = "L0",
+    seed: int = 0,
+    base_dir: Path | None = None,
+    allowed_roots: Sequence[Path] = (),
+    embodiment: EmbodimentSpec | None = None,
+    physics: PhysicsSpec | None = None,
+) -> SceneSpec:
+    """Lower the layout of ``scenario`` (as given: canonical for L0; a variant generator
+    passes its re-placed scenario with ``level="L1"``/``"L2"``) to a :class:`SceneSpec`.
+
+    ``base_dir`` defaults to the folder of the ``.fsv`` file that declared each object;
+    ``allowed_roots`` bound file assets (see ``build_asset``). ``embodiment`` overrides
+    loading ``scenario.embodiment`` by name. Raises :class:`LoweringError`."""
+    objects = {o.name: o for o in scenario.objects}
+    zone_names = {z.name for z in scenario.zones}
+
+    for obj in scenario.objects:
+        sup = obj.placement.support
+        if sup != WORLD and sup not in objects:
+            hint = "zones are not surfaces" if sup in zone_names else None
+            raise LoweringError(f"object {obj.name!r} stands on {sup!r}, which is not an object",
+                                obj.source, hint=hint)
+        if sup == obj.name:
+            raise LoweringError(f"object {obj.name!r} stands on itself", obj.source)
+    try:
+        order = support_order({o.name: o.placement.support for o in scenario.objects}, (WORLD,))
+    except CycleError as err:
+        raise LoweringError(f"objects support each other in a cycle: {' -> '.join(err.cycle)}",
+                            objects[err.cycle[0]].source) from None
+
+    # Build every asset first.
+    assets: dict[str, RigidAsset | ArticulatedAsset] = {}
+    for obj in scenario.objects:
+        folder = base_dir if base_dir is not None else Path(obj.source.file).parent
+        try:
+            assets[obj.name] = build_asset(obj.asset, obj.params, base_dir=folder,
+                                           allowed_roots=allowed_roots)
+        except (ValueError, OSError) as err:
+            raise LoweringError(f"object {obj.name!r}: cannot build asset {obj.asset!r}: {err}",
+                                obj.source) from err
+
+    # The floor: the table stands on it, its top is z = 0.
+    table = objects.get("table")
+    ground_z = 0.0
+    if table is not None and table.placement.support == WORLD:
+        ground_z = -(_surface_height(assets["table"]) + table.placement.height)
+    world = _Frame((0.0, 0.0), 0.0, ground_z, None)
+
+    frames: dict[str, _Frame] = {WORLD: world}
+    poses: dict[str, Pose] = {}
+    yaws: dict[str, float] = {}
+    for name in order:
+        obj = objects[name]
+        asset = assets[name]
+        support = frames[obj.placement.support]
+        pose, world_yaw = _place(support, obj.placement.position, obj.placement.height,
+                                 obj.placement.yaw)
+        poses[name], yaws[name] = pose, world_yaw
+        frames[name] = _Frame((pose.position[0], pose.position[1]), world_yaw,
+                              pose.position[2] + _surface_height(asset), _rect_of(asset))
+
+    # Overhang: a footprint whose centre leaves its support's top.
+    on_support: dict[str, list[_Footprint]] = {}
+    for obj in scenario.objects:
+        asset = assets[obj.name]
+        p = obj.placement
+        rect = placed_rect(asset.footprint.min_xy, asset.footprint.max_xy, p.position, p.yaw)
+        z0 = poses[obj.name].position[2] + asset.bounds.center[2] - asset.bounds.half_extents[2]
+        z1 = poses[obj.name].position[2] + asset.bounds.center[2] + asset.bounds.half_extents[2]
+        on_support.setdefault(p.support, []).append(
+            _Footprint(obj.name, "object", rect, (z0, z1), obj.source))
+        top = frames[p.support].top
+        if top is None:
+            continue
+        over = rect.overhang(top)
+        for axis, (amount, size) in enumerate(zip(over, rect.size)):
+            if amount > 0.5 * size + OVERLAP_TOLERANCE:
+                raise LoweringError(
+                    f"object {obj.name!r} overhangs the top of {p.support!r} by {amount:.4f} m "
+                    f"along {'xy'[axis]}, more than half its size ({size:.4f} m): its footprint "
+                    f"{rect} vs the top {top} (in {p.support!r}'s frame)",
+                    obj.source, hint="move it onto the support or make the support larger")
+
+    # Zones.
+    zones: list[SceneZone] = []
+    for zone in scenario.zones:
+        p = zone.placement
+        if p.support != WORLD and p.support not in objects:
+            raise LoweringError(f"zone {zone.name!r} lies on {p.support!r}, which is not an object",
+                                zone.source)
+        support_size = None
+        if p.support in assets:
+            support_size = frames[p.support].top.size  # type: ignore[union-attr]
+        try:
+            marker = build_zone_marker(zone.kind, zone.params, support_size=support_size)
+        except ValueError as err:
+            raise LoweringError(f"zone {zone.name!r}: cannot build {zone.kind!r}: {err}",
+                                zone.source) from err
+        pose, world_yaw = _place(frames[p.support], p.position, p.height, p.yaw)
+        region_box = _shape_box(marker.region)
+        if region_box is None:
+            b = marker.bounds
+            region_box = (tuple(c - h for c, h in zip(b.center, b.half_extents)),
+                          tuple(c + h for c, h in zip(b.center, b.half_extents)))
+        lo, hi = aabb(transform_points(box_corners(
+            tuple((a + b) / 2 for a, b in zip(*region_box)),
+            tuple((b - a) / 2 for a, b in zip(*region_box))), pose.position, pose.quaternion))
+        zones.append(SceneZone(name=zone.name, kind=zone.kind, marker=marker, pose=pose,
+                               region=marker.region, region_bounds=Box3(min=lo, max=hi),
+                               support=p.support, source=zone.source))
+        # A zone's collision walls (corridor) are static bodies on the support.
+        for i, wall in enumerate(marker.collision):
+            box = _shape_box(wall)
+            if box is None:
+                continue
+            rect = placed_rect(box[0][:2], box[1][:2], p.position, p.yaw)
+            z = (pose.position[2] + box[0][2], pose.position[2] + box[1][2])
+            on_support.setdefault(p.support, []).append(
+                _Footprint(zone.name, f"wall {wall.name or i}", rect, z, zone.source))
+
+    # Overlaps among the things on one support.
+    for support, items in on_support.items():
+        for i, a in enumerate(items):
+            for b in items[i + 1:]:
+                if a.name == b.name:
+                    continue
+                if min(a.z[1], b.z[1]) - max(a.z[0], b.z[0]) <= OVERLAP_TOLERANCE:
+                    continue
+                if a.rect.overlaps(b.rect):
+                    ox, oy = a.rect.overlap(b.rect)
+                    later = b  # report the one written second, naming the first
+                    what_a = f"{a.what} {a.name!r}" if a.what == "object" else f"{a.name!r} ({a.what})"
+                    what_b = f"{b.what} {b.name!r}" if b.what == "object" else f"{b.name!r} ({b.what})"
+                    raise LoweringError(
+                        f"{what_b} overlaps {what_a} on {support!r} by {ox:.4f} m x {oy:.4f} m: "
+                        f"footprints {b.rect} and {a.rect} (in {support!r}'s frame; "
+                        f"written at {a.source.file}:{a.source.line}:{a.source.column})",
+                        later.source, hint="move one of them apart")
+
+    bodies = tuple(
+        SceneBody(
+            name=obj.name,
+            asset=assets[obj.name],
+            pose=poses[obj.name],
+            is_static=(assets[obj.name].is_static if isinstance(assets[obj.name], RigidAsset)
+                       else assets[obj.name].fixed_base),  # type: ignore[union-attr]
+            hazard_role=obj.hazard_role,
+            support=obj.placement.support,
+            source=obj.source,
+        )
+        for obj in scenario.objects
+    )
+
+    spec = embodiment if embodiment is not None else _load_embodiment(scenario)
+    mounts = tuple(
+        RobotMount(robot=r.name,
+                   pose=Pose(position=tuple(r.mount.position), quaternion=yaw_quaternion(r.mount.yaw)),
+                   arms=tuple(a.name for a in r.arms))
+        for r in spec.robots
+    )
+    ee_links = {a.name: a.ee_link for r in spec.robots for a in r.arms}
+    cameras = tuple(
+        SceneCamera(name=c.name, parent=c.parent,
+                    link=None if c.parent == WORLD else ee_links[c.parent],
+                    pose=Pose(position=tuple(c.position), quaternion=tuple(c.orientation())),
+                    fovy=c.fovy, width=c.width, height=c.height, near=c.near, far=c.far)
+        for c in spec.cameras
+    )
+    return SceneSpec(
+        scenario=scenario.name,
+        source_digest=scenario.source_digest,
+        level=level,
+        seed=seed,
+        ground_z=ground_z,
+        bodies=bodies,
+        zones=tuple(zones),
+        embodiment=spec,
+        mounts=mounts,
+        cameras=cameras,
+        physics=physics if physics is not None else PhysicsSpec(),
+    )
+
+
+def _load_embodiment(scenario: Scenario) -> EmbodimentSpec:
+    try:
+        return load_embodiment(scenario.embodiment)
+    except Exception as err:  # unknown name, bad file: point at the scenario
+        raise LoweringError(f"cannot load embodiment {scenario.embodiment!r}: {err}",
+                            scenario.source) from err
+
+
+__all__ = [
+    "DEFAULT_LIGHTS", "SCENE_SCHEMA_VERSION", "AmbientLight", "Box3", "DirectionalLight",
+    "Light", "LoweringError", "PhysicsSpec", "PointLight", "RobotMount", "SceneBody",
+    "SceneCamera", "SceneSpec", "SceneZone", "lower_scene", "scene_json_schema",
+    "scene_json_schema_text",
+]
