@@ -2,12 +2,22 @@
 
 from __future__ import annotations
 
-import ast as python_ast
+import re
 
 from lark import Token, Transformer, Tree, v_args
 
 from . import ast
 from .spans import Span
+
+_ESCAPES = {'"': '"', "\\": "\\", "n": "\n", "t": "\t"}
+
+
+def unquote(token: str) -> str:
+    """The text of a STRING token: `\\"`, `\\\\`, `\\n` and `\\t` are escapes; any other backslash is kept.
+
+    (Not Python's literal_eval, which fails on `\\N` or `\\x4` and warns on `\\q`.)
+    """
+    return re.sub(r"\\(.)", lambda m: _ESCAPES.get(m.group(1), m.group(0)), token[1:-1], flags=re.DOTALL)
 
 
 @v_args(meta=True)
@@ -39,7 +49,7 @@ class AstBuilder(Transformer):
         return self._string(children[0])
 
     def _string(self, token: Token) -> ast.String:
-        return ast.String(python_ast.literal_eval(str(token)), Span.of(self.file, token))
+        return ast.String(unquote(str(token)), Span.of(self.file, token))
 
     def ref(self, meta, children):
         return ast.Ref(str(children[0]), self._span(meta))
@@ -206,7 +216,7 @@ class AstBuilder(Transformer):
     def extends(self, meta, children):
         token = children[0]
         if token.type == "STRING":
-            return ast.Extends(python_ast.literal_eval(str(token)), True, self._span(meta))
+            return ast.Extends(unquote(str(token)), True, self._span(meta))
         return ast.Extends(str(token), False, self._span(meta))
 
     def scenario(self, meta, children):

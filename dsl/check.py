@@ -142,15 +142,18 @@ class ScenarioChecker:
             return None
         roles = TASKS[name]
         bound: dict[str, str] = {}
+        argument_problem = False
         for index, argument in enumerate(call.arguments):
             role = argument.keyword.value if argument.keyword else (roles[index] if index < len(roles) else None)
             if role is None:
                 self.sink.error("FSV305", f"too many arguments for task `{name}`", argument.span,
                                 f"`{name}` takes {', '.join(roles)}")
+                argument_problem = True
                 continue
             if role not in roles:
                 self.sink.error("FSV303", f"task `{name}` has no role `{role}`", argument.keyword.span,
                                 "not a role of this task", help=did_you_mean(role, roles, "roles"))
+                argument_problem = True
                 continue
             if role in bound:
                 self.sink.error("FSV208", f"role `{role}` is given twice", argument.span, "given again")
@@ -158,8 +161,10 @@ class ScenarioChecker:
             target = self._object_ref(argument.value, f"role `{role}` of task `{name}`")
             if target is not None:
                 bound[role] = target
+            else:
+                argument_problem = True
         for role in roles:
-            if role not in bound and not any(d.code in ("FSV101", "FSV111") for d in self.sink.items):
+            if role not in bound and not argument_problem:
                 self.sink.error("FSV303", f"task `{name}` needs its `{role}`", call.span,
                                 f"missing `{role}`",
                                 help=f"write `task {name}({', '.join(f'{r}=...' for r in roles)})`")
@@ -180,6 +185,8 @@ class ScenarioChecker:
     def _entity(self, name: str, span: Span, what: str, allow_zone: bool = True) -> str | None:
         if name in self.objects or name in self._robot_parts() or (allow_zone and name in self.zones):
             return name
+        if self._failed_declaration(name):
+            return None  # declared, but it has errors of its own that are already reported
         if name in self.zones:
             self.sink.error("FSV111", f"`{name}` is a zone, not a body, so {what} cannot be it", span,
                             "a zone", help="name an object or a part of the robot")
@@ -193,12 +200,20 @@ class ScenarioChecker:
                         help=did_you_mean(name, self._entity_names(), "names"))
         return None
 
+    def _failed_declaration(self, name: str) -> bool:
+        """An object or hazard that is declared but was dropped for errors of its own."""
+        decl = self.merged.declarations.get(name)
+        return (isinstance(decl, (ast.ObjectDecl, ast.HazardDecl))
+                and name not in self.objects and name not in self.zones)
+
     def _object_ref(self, value: ast.Value, what: str) -> str | None:
         if not isinstance(value, ast.Ref):
             self.sink.error("FSV207", f"{what} must name an object", value.span, "expected a name")
             return None
         if value.name in self.objects:
             return value.name
+        if self._failed_declaration(value.name):
+            return None  # declared, but it has errors of its own that are already reported
         if value.name in self.zones or value.name in self._robot_parts():
             self.sink.error("FSV111", f"{what} must be an object, and `{value.name}` is "
                             f"{'a zone' if value.name in self.zones else 'part of the robot'}",
@@ -211,7 +226,8 @@ class ScenarioChecker:
     # ======================================================== declarations
     def _declarations(self) -> None:
         decls = self.merged.declarations
-        objects = [d for d in decls.values() if isinstance(d, ast.ObjectDecl)]
+        objects = sorted((d for d in decls.values() if isinstance(d, ast.ObjectDecl)),
+                         key=lambda d: d.name.value != "table")  # the IR lists the table first
         hazards = [d for d in decls.values() if isinstance(d, ast.HazardDecl)]
         if "table" not in decls:
             self.objects["table"] = models.ObjectSpec(
@@ -334,14 +350,16 @@ class ScenarioChecker:
             raw[name] = self._placement_parts(name, decl, kinds, declared)
         resolved: dict[str, models.Placement] = {}
         visiting: list[str] = []
+        in_cycle: set[str] = set()
 
         def resolve(name: str) -> models.Placement | None:
             if name in resolved:
                 return resolved[name]
-            if name not in raw:
+            if name not in raw or name in in_cycle:
                 return None
             if name in visiting:
                 cycle = visiting[visiting.index(name):] + [name]
+                in_cycle.update(cycle)
                 decl = declared[name]
                 self.sink.error("FSV307", "placement relations form a cycle: " + " -> ".join(cycle),
                                 decl.name.span, "placed relative to itself",
@@ -374,7 +392,8 @@ class ScenarioChecker:
         return resolved
 
     def _placement_parts(self, name, decl, kinds, declared) -> dict:
-        parts = {"position": (0.0, 0.0), "height": 0.0, "yaw": 0.0, "support": "table",
+        parts = {"position": (0.0, 0.0), "height": 0.0, "yaw": 0.0,
+                 "support": "world" if name == "table" else "table",  # a declared table stands on the world
                  "support_given": False, "relation": None}
         seen: dict[str, Span] = {}
         is_zone = kinds[name].asset_class is AssetClass.ZONE
@@ -462,10 +481,12 @@ class ScenarioChecker:
                                     "warning band before the hard limit (paper eq. 1)")
                     soft = None
             elif modifier.kind == "cost":
-                shaping = modifier.value.value
-                if shaping not in SHAPINGS:
-                    self.sink.error("FSV109", f"unknown cost shaping `{shaping}`", modifier.value.span,
-                                    "not a shaping", help=did_you_mean(shaping, SHAPINGS, "shapings"))
+                if modifier.value.value in SHAPINGS:
+                    shaping = modifier.value.value
+                else:
+                    self.sink.error("FSV109", f"unknown cost shaping `{modifier.value.value}`",
+                                    modifier.value.span, "not a shaping",
+                                    help=did_you_mean(modifier.value.value, SHAPINGS, "shapings"))
             else:
                 value = self.values.quantity(modifier.value, Dimension.NUMBER, "the weight")
                 if value is not None and value < 0:
@@ -881,8 +902,8 @@ class ScenarioChecker:
 
     # ============================================================ coverage
     def _suite_coverage(self, suite: str | None, setting: ast.Setting | None) -> None:
-        if suite is None or setting is None or self.scenario.abstract:
-            return
+        if suite is None or setting is None or self.scenario.abstract or self.sink.has_errors:
+            return  # with errors, a broken limit of the suite would be counted as missing
         covered = {limit.family for limit in self.limits}
         if self.requirements:
             covered.add("temporal")

@@ -167,7 +167,7 @@ class ScenarioLoader:
             if candidate.is_file():
                 return candidate
             sink.error("FSV401", f"no file `{extends.target}` to extend", extends.span, "not found",
-                       help=f"the path is relative to {self.display(path.parent) or '.'}")
+                       help=f"the path is relative to the scenario's folder (`{self.display(path.parent)}`)")
             return None
         searched = list(_base_candidates(path, extends.target, roots))
         for candidate in searched:
@@ -188,7 +188,7 @@ class ScenarioLoader:
                 return None
             if not candidate.is_file():
                 sink.error("FSV404", f"asset file `{value.value}` not found", value.span, "no such file",
-                           help=f"paths are relative to the scenario's folder, {self.display(path.parent)}")
+                           help=f"paths are relative to the scenario's folder (`{self.display(path.parent)}`)")
                 return None
             return str(candidate)
         return resolve

@@ -177,7 +177,7 @@ def _unexpected_token(error: UnexpectedToken, text: str, file: str, parser: Lark
     if previous is not None and previous.type == "NUMBER" and "UNIT" in expected and token.type == "NAME":
         return Diagnostic(code="FSV202", message=f"unknown unit `{token.value}`", span=span,
                           label="not a unit",
-                          help=did_you_mean(token.value, UNITS, "units"))
+                          help=_unit_help(token.value))
     if token.type == "_INDENT":
         return Diagnostic(code="FSV004", message="unexpected indentation", span=span,
                           label="this line is indented deeper than the statement above",
@@ -204,10 +204,25 @@ def _unexpected_token(error: UnexpectedToken, text: str, file: str, parser: Lark
         return Diagnostic(code="FSV009", message=f"unexpected {found} after a complete statement",
                           span=span, label="the statement already ended before this",
                           help=f"remove it, or put it on a line of its own; here the grammar expects "
-                               f"{describe_expected(expected - {'_NL'}, parser)} or the end of the line"
+                               f"{describe_expected(expected, parser)}"
                           if expected - {"_NL"} else "remove it, or put it on a line of its own")
     return Diagnostic(code="FSV002", message=f"unexpected {found}", span=span,
                       label=f"expected {describe_expected(expected, parser)}")
+
+
+# Units as people write them out, for the "did you mean" of an unknown unit.
+_UNIT_WORDS = {"sec": "s", "second": "s", "meter": "m", "metre": "m", "newton": "N", "nm": "Nm",
+               "degree": "deg", "radian": "rad", "gram": "g", "kilogram": "kg", "hz": "Hz"}
+
+
+def _unit_help(word: str) -> str | None:
+    singular = word[:-1] if word.endswith("s") and len(word) > 1 else word
+    for candidate in (word, singular, word.lower(), singular.lower()):
+        if candidate in UNITS and candidate != word:
+            return f"did you mean `{candidate}`?"
+        if candidate in _UNIT_WORDS:
+            return f"did you mean `{_UNIT_WORDS[candidate]}`?"
+    return did_you_mean(word, UNITS, "units")
 
 
 def _acceptable(error: UnexpectedToken) -> set[str]:
