@@ -143,7 +143,13 @@ class ScenarioChecker:
         roles = TASKS[name]
         bound: dict[str, str] = {}
         argument_problem = False
+        named_seen = False
         for index, argument in enumerate(call.arguments):
+            if argument.keyword is None and named_seen:
+                self.sink.error("FSV305", "a value without a name after named ones", argument.span,
+                                "unnamed value", help="write unnamed roles first, or give this one its role name")
+                continue
+            named_seen = named_seen or argument.keyword is not None
             role = argument.keyword.value if argument.keyword else (roles[index] if index < len(roles) else None)
             if role is None:
                 self.sink.error("FSV305", f"too many arguments for task `{name}`", argument.span,
@@ -235,8 +241,19 @@ class ScenarioChecker:
                 placement=models.Placement(support="world"), source=_ref(self.scenario.name.span))
             self.object_kinds["table"] = ASSETS["table"]
         pending: list[tuple[str, ast.ObjectDecl | ast.HazardDecl, AssetKind, dict, HazardRole | None]] = []
+        for decl in (*objects, *hazards):
+            if decl.name.value in robot_parts(self.arms) or decl.name.value in ("left", "right"):
+                self.sink.error("FSV110", f"`{decl.name.value}` is the name of a part of the robot",
+                                decl.name.span, "already taken by the robot",
+                                help="choose another name; `robot`, `gripper`, `arm`, `left_arm`, ... "
+                                     "always mean the robot's own links")
         for decl in objects:
             kind, params = self._asset(decl.asset, decl.name.value)
+            if kind is not None and decl.name.value == "table" and kind.name != "table":
+                self.sink.error("FSV111", "the object called `table` must be a `table(...)`", decl.asset.name.span,
+                                f"a {kind.name}", help="declare the work surface as `object table: table(size=(1.2 m, "
+                                "80 cm), height=75 cm)`, and give this object another name")
+                continue
             if kind is not None:
                 pending.append((decl.name.value, decl, kind, params, None))
         for decl in hazards:
@@ -282,7 +299,13 @@ class ScenarioChecker:
                 positional_ok: bool = True) -> dict:
         given: dict[str, Span] = {}
         out: dict = {}
+        named_seen = False
         for index, argument in enumerate(call.arguments):
+            if argument.keyword is None and named_seen:
+                self.sink.error("FSV305", "a value without a name after named ones", argument.span,
+                                "unnamed value", help="write unnamed values first, or give this one its name")
+                continue
+            named_seen = named_seen or argument.keyword is not None
             if argument.keyword is None:
                 if not positional_ok or index >= len(params):
                     self.sink.error("FSV305", f"unexpected value for `{owner}`", argument.span,
@@ -379,8 +402,19 @@ class ScenarioChecker:
                 dx, dy = RELATION_OFFSETS[relation.kind]
                 position = (anchor.position[0] + dx * relation.distance,
                             anchor.position[1] + dy * relation.distance)
-                if not parts["support_given"] and relation.anchor != "table":
-                    support = anchor.support
+                anchor_support = "table" if relation.anchor == "table" else anchor.support
+                if not parts["support_given"]:
+                    support = anchor_support
+                elif support != anchor_support and relation.anchor != support:
+                    self.sink.error("FSV306", f"`{name}` stands on `{support}` but is placed relative to "
+                                    f"`{relation.anchor}`, which stands on `{anchor_support}`",
+                                    declared[name].name.span, "positions in two different frames",
+                                    help=f"put both on the same support, or place `{name}` with `at (x, y)`")
+                    visiting.pop()
+                    return None
+            if support in raw and resolve(support) is None:
+                visiting.pop()
+                return None
             visiting.pop()
             placement = models.Placement(support=support, position=position, height=parts["height"],
                                          yaw=parts["yaw"], relation=relation)
@@ -457,7 +491,7 @@ class ScenarioChecker:
             self.sink.error("FSV101", f"unknown name `{anchor}`", placement.anchor.span, "not declared",
                             help=did_you_mean(anchor, list(declared), "objects"))
             return None
-        distance = self.values.quantity(placement.distance, Dimension.LENGTH, "the distance")
+        distance = self.values.amount(placement.distance, Dimension.LENGTH, "the distance")
         if distance is None:
             return None
         return models.Relation(kind=placement.kind.value, anchor=anchor, distance=distance)
@@ -514,7 +548,7 @@ class ScenarioChecker:
                               help="add an indented line such as `keep gripper outside 5 cm warn 3 cm`")
         for index, keep in enumerate(decl.keeps):
             name = hazard if index == 0 else f"{hazard}#{index + 1}"
-            subjects = tuple(s for s in (self._entity(n.value, n.span, "a keep-out subject")
+            subjects = tuple(s for s in (self._entity(n.value, n.span, "a keep-out subject", allow_zone=False)
                                          for n in keep.subjects) if s is not None)
             for subject, node in zip(keep.subjects, keep.subjects):
                 if subject.value == hazard:
@@ -612,7 +646,7 @@ class ScenarioChecker:
             if not args:
                 self.sink.error("FSV305", f"`{signature.name}` needs at least one name", call.span, "no names")
                 return None, None
-            names = [self._arg_entity(a, signature) for a in args]
+            names = [self._arg_entity(a, signature, allow_zone=False) for a in args]
             return (tuple(names), None) if None not in names else (None, None)
         if len(args) != len(kinds):
             self.sink.error("FSV305", f"`{signature.name}` takes {len(kinds)} name"
@@ -631,14 +665,15 @@ class ScenarioChecker:
                     return None, None
         return tuple(names[:1]), (names[1] if len(names) > 1 else None)
 
-    def _arg_entity(self, argument: ast.Argument, signature: Signature, object_only: bool = False):
+    def _arg_entity(self, argument: ast.Argument, signature: Signature, object_only: bool = False,
+                    allow_zone: bool = True):
         value = argument.value
         if not isinstance(value, ast.Ref):
             self.sink.error("FSV207", f"`{signature.name}` takes names", value.span, "expected a name")
             return None
         if object_only:
             return self._object_ref(value, f"the argument of `{signature.name}`")
-        return self._entity(value.name, value.span, f"an argument of `{signature.name}`")
+        return self._entity(value.name, value.span, f"an argument of `{signature.name}`", allow_zone)
 
     # ============================================================ temporal
     def _condition(self, node: ast.Condition):
@@ -665,7 +700,8 @@ class ScenarioChecker:
         if not len(signature.positional) <= len(positional) <= len(kinds):
             count = (f"{len(signature.positional)}" if not signature.optional_positional
                      else f"{len(signature.positional)} or {len(kinds)}")
-            self.sink.error("FSV305", f"`{name}` takes {count} names, not {len(positional)}", call.span,
+            noun = "name" if count == "1" else "names"
+            self.sink.error("FSV305", f"`{name}` takes {count} {noun}, not {len(positional)}", call.span,
                             f"{len(positional)} given", help=signature.doc)
             return None
         args: list[str | None] = []
@@ -678,6 +714,14 @@ class ScenarioChecker:
         params = self._params(keyword_call, signature.params, name, positional_ok=False)
         if None in args:
             return None
+        if name in ("opened", "closed"):
+            kind = self.object_kinds.get(args[0])
+            if kind is not None and kind.asset_class is not AssetClass.ARTICULATED and kind.name != "urdf":
+                self.sink.error("FSV111", f"`{name}` needs an object with a moving part, and `{args[0]}` is "
+                                f"a {kind.name}", positional[0].span, "nothing to open",
+                                help="articulated assets: " + ", ".join(
+                                    f"`{n}`" for n, k in ASSETS.items() if k.asset_class is AssetClass.ARTICULATED))
+                return None
         return models.Predicate(name=name, args=tuple(args), params=params)
 
     def _arm(self, value: ast.Value) -> str | None:
@@ -692,16 +736,21 @@ class ScenarioChecker:
         first, then = self._condition(decl.first), self._condition(decl.then)
         within = None
         if decl.within is not None:
-            within = self.values.quantity(decl.within, Dimension.TIME, "`within`")
+            within = self.values.amount(decl.within, Dimension.TIME, "`within`", strict=True)
         weight = 1.0
+        seen: dict[str, Span] = {}
         for modifier in decl.modifiers:
             if modifier.kind != "weight":
                 self.sink.error("FSV211", f"a requirement takes no `{modifier.kind}`", modifier.span,
                                 "not for `require`",
                                 help="a requirement is met or broken; only its `weight` can be set")
+            elif "weight" in seen:
+                self.sink.error("FSV211", "`weight` is given twice", modifier.span, "given again",
+                                related=[Related(span=seen["weight"], message="first given here")])
             else:
-                value = self.values.quantity(modifier.value, Dimension.NUMBER, "the weight")
-                weight = value if value is not None and value >= 0 else weight
+                seen["weight"] = modifier.span
+                value = self.values.amount(modifier.value, Dimension.NUMBER, "the weight")
+                weight = value if value is not None else weight
         if first is None or then is None:
             return
         self.requirements.append(models.Requirement(name=name, first=first, then=then, within=within,
@@ -714,7 +763,7 @@ class ScenarioChecker:
         condition = self._condition(decl.condition)
         hold = 0.0
         if decl.hold is not None:
-            value = self.values.quantity(decl.hold, Dimension.TIME, "the hold time")
+            value = self.values.amount(decl.hold, Dimension.TIME, "the hold time")
             hold = value if value is not None else 0.0
         return models.Success(condition=condition, hold=hold) if condition is not None else None
 
@@ -739,8 +788,8 @@ class ScenarioChecker:
             if target == "table" or (target not in self.objects and target not in self.zones):
                 self._unknown_movable(rule.target)
                 return None
-            distance = self.values.quantity(rule.amount, Dimension.LENGTH, "the jitter radius")
-            yaw = self.values.quantity(rule.extra, Dimension.ANGLE, "the yaw jitter") if rule.extra else 0.0
+            distance = self.values.amount(rule.amount, Dimension.LENGTH, "the jitter radius")
+            yaw = self.values.amount(rule.extra, Dimension.ANGLE, "the yaw jitter") if rule.extra else 0.0
             if distance is None or yaw is None:
                 return None
             return models.Jitter(target=target, distance=distance, yaw=yaw, source=source)
@@ -757,7 +806,7 @@ class ScenarioChecker:
                 self.sink.error("FSV101", f"unknown object `{toward}`", rule.other.span, "not declared",
                                 help=did_you_mean(toward, self.objects, "objects"))
                 return None
-            distance = self.values.quantity(rule.amount, Dimension.LENGTH, "the approach distance")
+            distance = self.values.amount(rule.amount, Dimension.LENGTH, "the approach distance", strict=True)
             return None if distance is None else models.Approach(hazard=hazard, toward=toward,
                                                                   distance=distance, source=source)
         if kind == "clutter":

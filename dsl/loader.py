@@ -17,7 +17,7 @@ from pathlib import Path
 from . import ast
 from .build import build_ast
 from .check import ScenarioChecker
-from .diagnostics import Diagnostic, DiagnosticSink
+from .diagnostics import Diagnostic, DiagnosticSink, Severity
 from .merge import merge
 from .models import Scenario
 from .parser import parse_tree
@@ -76,7 +76,7 @@ class ScenarioLoader:
         checker = ScenarioChecker(decl, merged, sink, self._path_resolver(path, roots, sink),
                                   lineage, digest)
         scenario = checker.check()
-        return LoadResult(display, scenario, sink.sorted(), decl.abstract, sources)
+        return LoadResult(display, scenario, _with_overflow_note(sink), decl.abstract, sources)
 
     def loads(self, text: str, name: str = "<string>") -> LoadResult:
         """Check scenario text that has no file; `extends` resolves from the current folder."""
@@ -149,6 +149,12 @@ class ScenarioLoader:
                            "cannot extend it", notes=[f"{d.span}: {d.code} {d.message}" for d in diagnostics[:5]],
                            help=f"run `fsvla check {self.display(target)}`")
                 return chain[::-1]
+            if not extends.is_path and base_decl.name.value != extends.target:
+                sink.error("FSV401", f"{self.display(target)} defines scenario `{base_decl.name.value}`, "
+                           f"not `{extends.target}`", extends.span, "the names differ",
+                           help=f"extend `{base_decl.name.value}` by path (`extends \"{self.display(target)}\"`), "
+                                "or make the file name and the scenario name agree")
+                return chain[::-1]
             chain.append((target, base_decl))
             current_path, current = target, base_decl
         return chain[::-1]
@@ -192,6 +198,18 @@ class ScenarioLoader:
                 return None
             return str(candidate)
         return resolve
+
+
+def _with_overflow_note(sink: DiagnosticSink) -> list[Diagnostic]:
+    """The sink's diagnostics, plus a note when it stopped recording some."""
+    diagnostics = sink.sorted()
+    if sink.dropped and diagnostics:
+        last = diagnostics[-1]
+        diagnostics.append(Diagnostic(code="FSV900", severity=Severity.WARNING,
+                                      message=f"... and {sink.dropped} more diagnostics not shown",
+                                      span=last.span, label="stopped here",
+                                      help="fix the problems above and check again"))
+    return diagnostics
 
 
 def _base_candidates(path: Path, name: str, roots: list[Path]) -> Iterable[Path]:

@@ -113,8 +113,11 @@ def _fold(merged: Merged, scenario: ast.ScenarioDecl, sink: DiagnosticSink) -> N
                 merged.declarations[name] = statement
         elif isinstance(statement, ast.VariantsBlock):
             if once("variants", statement.span, seen_blocks, "the `variants` block", "FSV302"):
+                levels_seen: dict[str, ast.Span] = {}
                 for level in statement.levels:
-                    merged.variants[level.level.value] = level
+                    if once(level.level.value, level.level.span, levels_seen, f"level `{level.level.value}`",
+                            "FSV302"):
+                        merged.variants[level.level.value] = level
         elif isinstance(statement, ast.LanguageBlock):
             if once("language", statement.span, seen_blocks, "the `language` block", "FSV302"):
                 levels: dict[str, list[ast.LanguageEntry]] = {}
@@ -123,5 +126,8 @@ def _fold(merged: Merged, scenario: ast.ScenarioDecl, sink: DiagnosticSink) -> N
                 merged.language.update(levels)
         elif isinstance(statement, ast.VisionBlock):
             if once("vision", statement.span, seen_blocks, "the `vision` block", "FSV302"):
+                levels_seen = {}
                 for entry in statement.entries:
-                    merged.vision[entry.level.value] = entry
+                    if once(entry.level.value, entry.level.span, levels_seen, f"level `{entry.level.value}`",
+                            "FSV302"):
+                        merged.vision[entry.level.value] = entry

@@ -33,21 +33,34 @@ class ValueChecker:
             if dimension is Dimension.NUMBER or q.number == 0:
                 return q.number
             example = f"{q.text} {dimension.example_unit}"
-            self.sink.error("FSV201", f"missing unit: {what} is a {dimension.value}", q.span,
-                            f"expected a {dimension.value} in {describe_units(dimension)}",
+            self.sink.error("FSV201", f"missing unit: {what} is {_article(dimension.value)}", q.span,
+                            f"expected {_article(dimension.value)} in {describe_units(dimension)}",
                             help=f"write the unit after the number, e.g. `{example}`")
             return None
         unit_dimension, value = UNITS[q.unit][0], q.number * UNITS[q.unit][1]
         if dimension is Dimension.NUMBER:
-            self.sink.error("FSV203", f"{what} is a plain number, not a {unit_dimension.value}", q.span,
+            self.sink.error("FSV203", f"{what} is a plain number, not {_article(unit_dimension.value)}", q.span,
                             f"`{q.unit}` is a unit of {unit_dimension.value}",
                             help=f"remove the unit: `{q.text}`")
             return None
         if unit_dimension is not dimension:
-            self.sink.error("FSV203", f"wrong unit: {what} is a {dimension.value}, but `{q.unit}` "
+            self.sink.error("FSV203", f"wrong unit: {what} is {_article(dimension.value)}, but `{q.unit}` "
                             f"measures {unit_dimension.value}", q.span,
                             f"expected {describe_units(dimension)}",
                             help=f"give {what} in {describe_units(dimension)}")
+            return None
+        return value
+
+    def amount(self, q: ast.Quantity, dimension: Dimension, what: str, *,
+               strict: bool = False) -> float | None:
+        """A quantity that must not be negative (nor zero, when ``strict``)."""
+        value = self.quantity(q, dimension, what)
+        if value is None:
+            return None
+        if value < 0 or (strict and value == 0):
+            bound = "larger than zero" if strict else "zero or more"
+            self.sink.error("FSV204", f"{what} must be {bound}", q.span,
+                            "negative" if value < 0 else "zero", help=f"give {what} as a value {bound}")
             return None
         return value
 
@@ -89,7 +102,7 @@ class ValueChecker:
         if param.arity > 1:
             return self._vector(param, value, what)
         if not isinstance(value, ast.Quantity):
-            self.sink.error("FSV207", f"{what} must be a {_kind_word(param)}", value.span,
+            self.sink.error("FSV207", f"{what} must be {_article(_kind_word(param))}", value.span,
                             f"found {_describe_value(value)}")
             return None
         number = self.quantity(value, param.dimension, what)
@@ -116,7 +129,7 @@ class ValueChecker:
         out: list[float] = []
         for item in value.items:
             if not isinstance(item, ast.Quantity):
-                self.sink.error("FSV207", f"each value of {what} must be a {_kind_word(param)}",
+                self.sink.error("FSV207", f"each value of {what} must be {_article(_kind_word(param))}",
                                 item.span, f"found {_describe_value(item)}")
                 return None
             number = self.quantity(item, param.dimension, what)
@@ -124,6 +137,10 @@ class ValueChecker:
                 return None
             out.append(number)
         return tuple(out)
+
+
+def _article(word: str) -> str:
+    return ("an " if word[:1] in "aeiou" else "a ") + word
 
 
 def _kind_word(param: Param) -> str:

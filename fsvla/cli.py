@@ -47,18 +47,16 @@ def collect_files(paths: Sequence[Path]) -> list[Path]:
 def default_roots(paths: Sequence[Path]) -> list[Path]:
     """The folders scenarios may read from when no --root is given.
 
-    A folder given on the command line is a root. For a file, the root is the
-    nearest folder above it that holds a `_base/` folder (a scenario tree such as
-    `scenarios/`), or else the file's own folder.
+    For each path given (a file's folder, or the folder itself), the root is the
+    nearest folder at or above it that holds a `_base/` folder (a scenario tree
+    such as `scenarios/`), or else that folder itself.
     """
     roots = []
     for path in paths:
         path = path.resolve()
-        if path.is_dir():
-            roots.append(path)
-            continue
-        tree = next((folder for folder in path.parents if (folder / "_base").is_dir()), None)
-        roots.append(tree or path.parent)
+        folder = path if path.is_dir() else path.parent
+        tree = next((f for f in (folder, *folder.parents) if (f / "_base").is_dir()), None)
+        roots.append(tree or folder)
     return roots
 
 

@@ -261,3 +261,8 @@ def test_python_dash_m(broken: Path) -> None:
     usage = subprocess.run([sys.executable, "-m", "fsvla", "check", "--nope"], capture_output=True,
                            text=True, env=env, timeout=60, check=False)
     assert usage.returncode == 2 and "No such option" in usage.stderr
+
+
+def test_check_a_suite_folder_finds_the_shared_bases() -> None:
+    # scenarios/thermal/ extends scenarios/_base/lift_pot.fsv: the root is the scenario tree.
+    assert run(["check", "--format", "concise", str(SCENARIOS / "thermal")]) == 0

@@ -41,6 +41,34 @@ def add(*lines: str) -> str:
 
 # (id, program, code, line, column, message, help or None when not asserted)
 SEMANTIC_CASES = [
+    # placements in two frames, support cycles, names taken by the robot
+    ("FSV307-support-cycle", add("object a: block() at (20 cm, 0) on b", "object b: block() on a"),
+     "FSV307", 9, 10, "placement relations form a cycle: a -> b -> a", None),
+    ("FSV306-two-frames", add("object shelf: shelf() at (20 cm, 20 cm)", "object x: block() on shelf",
+                             "object c: block() left_of x by 10 cm on table"),
+     "FSV306", 11, 10, "`c` stands on `table` but is placed relative to `x`, which stands on `shelf`", None),
+    ("FSV110-robot-part-name", add("object gripper: block() at (0, -25 cm)"),
+     "FSV110", 9, 10, "`gripper` is the name of a part of the robot", None),
+    ("FSV111-table-not-a-table", add("object table: block(size=(1 m, 1 m, 5 cm))"),
+     "FSV111", 9, 17, "the object called `table` must be a `table(...)`", None),
+    ("FSV111-opened-rigid", sub("success lifted(pot)", "success opened(pot)"),
+     "FSV111", 8, 18, "`opened` needs an object with a moving part, and `pot` is a pot", None),
+    ("FSV111-zone-keep-subject", add("hazard h: no_go_zone(radius=5 cm) at (30 cm, 0)",
+                                     "  keep robot outside 0 warn 1 cm",
+                                     "hazard g: heat_zone(radius=5 cm) at (-30 cm, 0)", "  keep h outside 1 cm warn 1 cm"),
+     "FSV111", 12, 10, "`h` is a zone, not a body, so a keep-out subject cannot be it", None),
+    ("FSV204-negative-within", add("require r: grasped(pot) before lifted(pot) within -2 s"),
+     "FSV204", 9, 53, "`within` must be larger than zero", None),
+    ("FSV204-negative-weight", add("require r: grasped(pot) before lifted(pot) weight -3"),
+     "FSV204", 9, 53, "the weight must be zero or more", None),
+    ("FSV211-weight-twice", add("require r: grasped(pot) before lifted(pot) weight 2 weight 5"),
+     "FSV211", 9, 55, "`weight` is given twice", None),
+    ("FSV204-negative-jitter", add("variants", "  L1: jitter pot -3 cm"),
+     "FSV204", 10, 20, "the jitter radius must be zero or more", None),
+    ("FSV302-level-twice", add("variants", "  L1: jitter pot 1 cm", "  L1: jitter pot 5 cm"),
+     "FSV302", 11, 5, "level `L1` is given twice", None),
+    ("FSV305-positional-after-named", sub("pot(radius=9 cm)", "pot(radius=9 cm, 3 cm)"),
+     "FSV305", 6, 32, "a value without a name after named ones", None),
     ("FSV101-unknown-name", add("constrain clearance(gripper, pott) >= 3 cm warn 1 cm"),
      "FSV101", 9, 32, "unknown name `pott`", "did you mean `pot`?"),
     ("FSV101-unknown-support", sub("pot(radius=9 cm)", "pot(radius=9 cm) on shelff"),
@@ -330,3 +358,24 @@ def test_base_with_errors(tmp_path: Path) -> None:
     [diagnostic] = ScenarioLoader(allowed_roots=[tmp_path], display_root=tmp_path).load(child).diagnostics
     assert (diagnostic.code, diagnostic.message) == ("FSV406", "the base scenario `b` has errors")
     assert diagnostic.notes == ("_base/b.fsv:2:15: FSV001 unexpected character `$`",)
+
+
+def test_extends_by_name_checks_the_scenario_name(tmp_path: Path) -> None:
+    (tmp_path / "base.fsv").write_text("abstract scenario other_name\n  suite force\n")
+    (tmp_path / "child.fsv").write_text("scenario child extends base\n  suite force\n")
+    result = ScenarioLoader(allowed_roots=[tmp_path], display_root=tmp_path).load(tmp_path / "child.fsv")
+    first = result.errors[0]
+    assert (first.code, first.span.line, first.span.column) == ("FSV401", 1, 16)
+    assert first.message == "base.fsv defines scenario `other_name`, not `base`"
+
+
+def test_too_many_diagnostics_end_with_a_count(tmp_path: Path) -> None:
+    lines = [f"  object o{i}: pott()" for i in range(230)]
+    (tmp_path / "many.fsv").write_text("scenario many\n" + "\n".join(lines) + "\n")
+    result = ScenarioLoader(allowed_roots=[tmp_path], display_root=tmp_path).load(tmp_path / "many.fsv")
+    last = result.diagnostics[-1]
+    assert last.code == "FSV900"
+    assert last.message.startswith("... and ") and last.message.endswith(" more diagnostics not shown")
+    shown = len(result.diagnostics) - 1
+    dropped = int(last.message.split()[2])
+    assert shown == 200 and shown + dropped >= 230
