@@ -52,7 +52,7 @@ from fsvla.compiler.assets import (
     build_zone_marker,
 )
 from fsvla.compiler.assets.model import Shape
-from fsvla.dsl.models import Scenario, SourceRef
+from fsvla.dsl.models import Scenario, SourceRef, versioned_json_schema
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from fsvla.embodiments import EmbodimentSpec, load_embodiment
@@ -232,10 +232,7 @@ class SceneSpec(_Model):
 
 def scene_json_schema() -> dict[str, Any]:
     """The JSON Schema of a SceneSpec, tagged with its version."""
-    schema = SceneSpec.model_json_schema()
-    schema["$id"] = f"urn:fsvla:schema:scene:{SCENE_SCHEMA_VERSION}"
-    schema["title"] = "fsvla scene"
-    return schema
+    return versioned_json_schema(SceneSpec, f"urn:fsvla:schema:scene:{SCENE_SCHEMA_VERSION}", "fsvla scene")
 
 
 def scene_json_schema_text() -> str:

@@ -225,9 +225,14 @@ class Scenario(_Model):
         return next((o for o in self.objects if o.name == name), None)
 
 
+def versioned_json_schema(model: type[BaseModel], urn: str, title: str) -> dict:
+    """The JSON Schema of ``model`` with its ``$id`` (a versioned URN) and title."""
+    schema = model.model_json_schema()
+    schema["$id"] = urn
+    schema["title"] = title
+    return schema
+
+
 def ir_json_schema() -> dict:
     """The JSON Schema of the scenario IR (``fsvla schema``)."""
-    schema = Scenario.model_json_schema()
-    schema["$id"] = f"urn:fsvla:schema:scenario:{SCHEMA_VERSION}"
-    schema["title"] = "fsvla scenario IR"
-    return schema
+    return versioned_json_schema(Scenario, f"urn:fsvla:schema:scenario:{SCHEMA_VERSION}", "fsvla scenario IR")

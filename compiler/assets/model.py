@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 from typing import Annotated, Any, Literal
 
+from fsvla.dsl.models import versioned_json_schema
 from pydantic import BaseModel, ConfigDict, Field, NonNegativeFloat, PositiveFloat, model_validator
 
 SCHEMA_VERSION = "1.0"
@@ -294,10 +295,7 @@ class _AssetDocument(_Model):
 
 def json_schema() -> dict[str, Any]:
     """The JSON Schema of an asset (rigid, articulated or zone), tagged with its version."""
-    schema = _AssetDocument.model_json_schema()
-    schema["$id"] = f"urn:fsvla:asset:{SCHEMA_VERSION}"
-    schema["title"] = "fsvla asset"
-    return schema
+    return versioned_json_schema(_AssetDocument, f"urn:fsvla:asset:{SCHEMA_VERSION}", "fsvla asset")
 
 
 def json_schema_text() -> str:
