@@ -14,7 +14,8 @@ from pydantic import ValidationError
 from . import ast, models
 from .catalog import (ASSETS, BIMANUAL_TASKS, EMBODIMENTS, LANGUAGE_CATEGORIES, METRICS, PREDICATES,
                       ROLE_CHANNEL, SHAPINGS, SUITES, TASKS, VISION_SETTINGS, ZONE_CHANNEL, ZONES,
-                      ArgKind, AssetClass, AssetKind, HazardRole, Param, Signature, robot_parts)
+                      ArgKind, AssetClass, AssetKind, HazardRole, Param, Signature, default_params,
+                      robot_parts)
 from .diagnostics import DiagnosticSink, Related, did_you_mean
 from .merge import Merged, declared_name, unparse
 from .spans import Span
@@ -237,7 +238,7 @@ class ScenarioChecker:
         hazards = [d for d in decls.values() if isinstance(d, ast.HazardDecl)]
         if "table" not in decls:
             self.objects["table"] = models.ObjectSpec(
-                name="table", asset="table", params=dict(_defaults(ASSETS["table"].params)),
+                name="table", asset="table", params=default_params(ASSETS["table"].params),
                 placement=models.Placement(support="world"), source=_ref(self.scenario.name.span))
             self.object_kinds["table"] = ASSETS["table"]
         pending: list[tuple[str, ast.ObjectDecl | ast.HazardDecl, AssetKind, dict, HazardRole | None]] = []
@@ -977,6 +978,3 @@ def _example(dimension: Dimension | None, small: bool = False) -> str:
     big, little = examples.get(dimension, ("1", "0.5"))
     return little if small else big
 
-
-def _defaults(params: tuple[Param, ...]) -> dict:
-    return {p.name: p.default for p in params if p.default is not None}
