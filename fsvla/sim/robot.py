@@ -77,6 +77,20 @@ class LoadedArm:
         for index, target in zip(self.gripper_indices, self.spec.gripper.targets(open)):
             joints[index].set_drive_target(float(target))
 
+    def set_gripper_opening(self, opening: float) -> None:
+        """Drive the gripper to ``opening`` in [0, 1]: 0 closed, 1 open, linear between."""
+        closed, open_ = self.spec.gripper.closed, self.spec.gripper.open
+        joints = self.articulation.active_joints
+        for index, lo, hi in zip(self.gripper_indices, closed, open_):
+            joints[index].set_drive_target(float(lo + opening * (hi - lo)))
+
+    def gripper_opening(self) -> float:
+        """How open the gripper is, in [0, 1] (the mean over its joints, clipped)."""
+        closed = np.asarray(self.spec.gripper.closed, dtype=np.float64)
+        span = np.asarray(self.spec.gripper.open, dtype=np.float64) - closed
+        ratio = (self.gripper_qpos() - closed) / np.where(span == 0.0, 1.0, span)
+        return float(np.clip(ratio.mean(), 0.0, 1.0))
+
     def tcp_pose(self) -> Any:
         """World pose (``sapien.Pose``) of the tool centre point."""
         import sapien
