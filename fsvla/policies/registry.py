@@ -1,0 +1,86 @@
+"""Turn a ``--policy`` argument into a policy object.
+
+Accepted forms:
+
+- a built-in name: ``random``, ``hold-still`` (and the scripted experts once they exist);
+- ``module:Class`` (or ``module:factory``): any importable class or callable that returns
+  an object with ``reset(episode)`` and ``act(observation)``; ``path/to/file.py:Class``
+  imports a file;
+- ``ws://host:port``: a policy server speaking the openpi websocket protocol.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from fsvla.dsl.diagnostics import did_you_mean
+
+from .base import Policy
+from .simple import HoldStillPolicy, RandomPolicy
+
+BUILTIN: dict[str, Callable[[], Any]] = {
+    "random": RandomPolicy,
+    "hold-still": HoldStillPolicy,
+}
+
+
+class PolicyLoadError(ValueError):
+    """A ``--policy`` value that names nothing usable."""
+
+
+def load_policy(spec: str) -> Policy:
+    """The policy ``spec`` names (see the module doc); raises :class:`PolicyLoadError`."""
+    if spec in BUILTIN:
+        return BUILTIN[spec]()
+    if spec.startswith(("ws://", "wss://")):
+        from .remote import RemotePolicy
+
+        return RemotePolicy(spec)
+    if ":" not in spec:
+        hint = did_you_mean(spec, BUILTIN)
+        raise PolicyLoadError(f"--policy {spec!r}: not a built-in policy, `module:Class` or "
+                              f"ws://host:port" + (f"; {hint}" if hint else ""))
+    module_name, _, attribute = spec.rpartition(":")
+    module = _import(module_name, spec)
+    factory = getattr(module, attribute, None)
+    if factory is None or not callable(factory):
+        raise PolicyLoadError(f"--policy {spec!r}: {module_name} has no class or factory "
+                              f"{attribute!r}")
+    try:
+        policy = factory()
+    except Exception as err:  # the user's constructor failed: say so, without a traceback
+        raise PolicyLoadError(f"--policy {spec!r}: constructing {attribute} failed: "
+                              f"{type(err).__name__}: {err}") from err
+    if not isinstance(policy, Policy):
+        raise PolicyLoadError(f"--policy {spec!r}: {attribute}() returned a "
+                              f"{type(policy).__name__}, which lacks reset(episode) and "
+                              "act(observation)")
+    return policy
+
+
+def _import(name: str, spec: str) -> Any:
+    if name.endswith(".py"):
+        path = Path(name)
+        if not path.is_file():
+            raise PolicyLoadError(f"--policy {spec!r}: no such file {name}")
+        loader_spec = importlib.util.spec_from_file_location(path.stem, path)
+        assert loader_spec is not None and loader_spec.loader is not None
+        module = importlib.util.module_from_spec(loader_spec)
+        try:
+            loader_spec.loader.exec_module(module)
+        except Exception as err:
+            raise PolicyLoadError(f"--policy {spec!r}: importing {name} failed: "
+                                  f"{type(err).__name__}: {err}") from err
+        return module
+    try:
+        return importlib.import_module(name)
+    except Exception as err:
+        raise PolicyLoadError(f"--policy {spec!r}: cannot import {name}: "
+                              f"{type(err).__name__}: {err}") from err
+
+
+__all__ = ["BUILTIN", "PolicyLoadError", "load_policy"]
