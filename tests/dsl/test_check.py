@@ -8,7 +8,9 @@ import pytest
 from fsvla.dsl.diagnostics import Severity
 from fsvla.dsl.loader import ScenarioLoader
 
-# The base program every case edits (tests/dsl/conftest.py has the same text):
+from .conftest import BASE
+
+# The base program every case edits (conftest.BASE), with its line numbers:
 #  1 scenario s
 #  2   suite force
 #  3   task lift(pot)
@@ -17,16 +19,6 @@ from fsvla.dsl.loader import ScenarioLoader
 #  6   object pot: pot(radius=9 cm)
 #  7   constrain contact_force(gripper) <= 30 N warn 8 N
 #  8   success lifted(pot)
-BASE = """\
-scenario s
-  suite force
-  task lift(pot)
-  embodiment panda
-  instruction "Lift the pot."
-  object pot: pot(radius=9 cm)
-  constrain contact_force(gripper) <= 30 N warn 8 N
-  success lifted(pot)
-"""
 
 
 def sub(old: str, new: str) -> str:
