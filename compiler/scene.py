@@ -39,7 +39,7 @@ overlap too. Exact collision checks (FCL) belong to variant generation.
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -264,7 +264,8 @@ class _Frame:
         self.xy, self.yaw, self.top_z, self.top = xy, yaw, top_z, top
 
 
-def _surface_height(asset: RigidAsset | ArticulatedAsset) -> float:
+def surface_height(asset: RigidAsset | ArticulatedAsset) -> float:
+    """Height of the surface other things stand on above ``asset``'s origin."""
     height = getattr(asset, "support_height", None)
     if height is not None:
         return float(height)
@@ -304,6 +305,15 @@ def _place(frame: _Frame, position: Sequence[float], height: float, yaw: float) 
     return pose, world_yaw
 
 
+def overhang_axis(rect: Rect, top: Rect) -> int | None:
+    """The axis (0 = x, 1 = y) along which ``rect`` overhangs ``top`` by more than half its
+    own size (its centre is off the support), or None when it rests on ``top``."""
+    for axis, (amount, size) in enumerate(zip(rect.overhang(top), rect.size)):
+        if amount > 0.5 * size + OVERLAP_TOLERANCE:
+            return axis
+    return None
+
+
 class _Footprint:
     """A thing on a support, for the overlap check (support frame)."""
 
@@ -322,13 +332,17 @@ def lower_scene(
     allowed_roots: Sequence[Path] = (),
     embodiment: EmbodimentSpec | None = None,
     physics: PhysicsSpec | None = None,
+    asset_builder: Callable[..., RigidAsset | ArticulatedAsset] = build_asset,
+    marker_builder: Callable[..., ZoneAsset] = build_zone_marker,
 ) -> SceneSpec:
     """Lower the layout of ``scenario`` (as given: canonical for L0; a variant generator
     passes its re-placed scenario with ``level="L1"``/``"L2"``) to a :class:`SceneSpec`.
 
     ``base_dir`` defaults to the folder of the ``.fsv`` file that declared each object;
     ``allowed_roots`` bound file assets (see ``build_asset``). ``embodiment`` overrides
-    loading ``scenario.embodiment`` by name. Raises :class:`LoweringError`."""
+    loading ``scenario.embodiment`` by name. ``asset_builder``/``marker_builder`` (same
+    signatures as ``build_asset``/``build_zone_marker``) let a caller that lowers many
+    layouts of one scenario reuse built assets. Raises :class:`LoweringError`."""
     objects = {o.name: o for o in scenario.objects}
     zone_names = {z.name for z in scenario.zones}
 
@@ -351,8 +365,8 @@ def lower_scene(
     for obj in scenario.objects:
         folder = base_dir if base_dir is not None else Path(obj.source.file).parent
         try:
-            assets[obj.name] = build_asset(obj.asset, obj.params, base_dir=folder,
-                                           allowed_roots=allowed_roots)
+            assets[obj.name] = asset_builder(obj.asset, obj.params, base_dir=folder,
+                                             allowed_roots=allowed_roots)
         except (ValueError, OSError) as err:
             raise LoweringError(f"object {obj.name!r}: cannot build asset {obj.asset!r}: {err}",
                                 obj.source) from err
@@ -361,7 +375,7 @@ def lower_scene(
     table = objects.get("table")
     ground_z = 0.0
     if table is not None and table.placement.support == WORLD:
-        ground_z = -(_surface_height(assets["table"]) + table.placement.height)
+        ground_z = -(surface_height(assets["table"]) + table.placement.height)
     world = _Frame((0.0, 0.0), 0.0, ground_z, None)
 
     frames: dict[str, _Frame] = {WORLD: world}
@@ -375,7 +389,7 @@ def lower_scene(
                                  obj.placement.yaw)
         poses[name], yaws[name] = pose, world_yaw
         frames[name] = _Frame((pose.position[0], pose.position[1]), world_yaw,
-                              pose.position[2] + _surface_height(asset), _rect_of(asset))
+                              pose.position[2] + surface_height(asset), _rect_of(asset))
 
     # Overhang: a footprint whose centre leaves its support's top.
     on_support: dict[str, list[_Footprint]] = {}
@@ -390,14 +404,14 @@ def lower_scene(
         top = frames[p.support].top
         if top is None:
             continue
-        over = rect.overhang(top)
-        for axis, (amount, size) in enumerate(zip(over, rect.size)):
-            if amount > 0.5 * size + OVERLAP_TOLERANCE:
-                raise LoweringError(
-                    f"object {obj.name!r} overhangs the top of {p.support!r} by {amount:.4f} m "
-                    f"along {'xy'[axis]}, more than half its size ({size:.4f} m): its footprint "
-                    f"{rect} vs the top {top} (in {p.support!r}'s frame)",
-                    obj.source, hint="move it onto the support or make the support larger")
+        axis = overhang_axis(rect, top)
+        if axis is not None:
+            amount, size = rect.overhang(top)[axis], rect.size[axis]
+            raise LoweringError(
+                f"object {obj.name!r} overhangs the top of {p.support!r} by {amount:.4f} m "
+                f"along {'xy'[axis]}, more than half its size ({size:.4f} m): its footprint "
+                f"{rect} vs the top {top} (in {p.support!r}'s frame)",
+                obj.source, hint="move it onto the support or make the support larger")
 
     # Zones.
     zones: list[SceneZone] = []
@@ -410,7 +424,7 @@ def lower_scene(
         if p.support in assets:
             support_size = frames[p.support].top.size  # type: ignore[union-attr]
         try:
-            marker = build_zone_marker(zone.kind, zone.params, support_size=support_size)
+            marker = marker_builder(zone.kind, zone.params, support_size=support_size)
         except ValueError as err:
             raise LoweringError(f"zone {zone.name!r}: cannot build {zone.kind!r}: {err}",
                                 zone.source) from err
@@ -510,6 +524,6 @@ def _load_embodiment(scenario: Scenario) -> EmbodimentSpec:
 __all__ = [
     "DEFAULT_LIGHTS", "SCENE_SCHEMA_VERSION", "AmbientLight", "Box3", "DirectionalLight",
     "Light", "LoweringError", "PhysicsSpec", "PointLight", "RobotMount", "SceneBody",
-    "SceneCamera", "SceneSpec", "SceneZone", "lower_scene", "scene_json_schema",
-    "scene_json_schema_text",
+    "SceneCamera", "SceneSpec", "SceneZone", "lower_scene", "overhang_axis", "scene_json_schema",
+    "scene_json_schema_text", "surface_height",
 ]

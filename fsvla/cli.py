@@ -130,27 +130,80 @@ def check(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str, 
 @_format_option
 @click.option("-o", "--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
               help="Folder to write the scenario IR into (created if missing).")
+@click.option("--levels", default="L0,L1,L2", show_default=True, callback=lambda _ctx, _param, v: parse_levels(v),
+              help="Layout levels to write scenes of, comma-separated.")
+@click.option("--seeds", default="0", show_default=True, callback=lambda _ctx, _param, v: parse_seeds(v),
+              help="Layout seeds: numbers and ranges, comma-separated (e.g. 0-4 or 0,3,7-9).")
 def compile_command(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str,
-                    out_dir: Path) -> None:
-    """Check scenarios and write each one's IR as versioned JSON into OUT.
+                    out_dir: Path, levels: tuple[str, ...], seeds: tuple[int, ...]) -> None:
+    """Check scenarios and write each one's IR as versioned JSON into OUT, and the scene of
+    each layout variant as OUT/<scenario>/scene_<level>_s<seed>.json.
 
     Abstract scenarios (bases for others) are checked but not written. A file with
-    errors writes nothing and leaves any earlier output of it untouched.
+    errors (in the language, or a layout that cannot be generated) writes nothing and
+    leaves any earlier output of it untouched.
     """
     results = _load_all(paths, roots)
+    scenes = _compile_scenes(results, levels, seeds, list(roots) or default_roots(paths))
     errors, _ = _report(results, output_format, quiet=True)
-    written = _write_ir(results, out_dir)
+    written = _write_ir(results, out_dir, scenes)
     if output_format == "full":
         out = _console()
-        for path in written:
-            out.print(f"[green]wrote[/green] {path}")
+        for path, count in written:
+            out.print(f"[green]wrote[/green] {path} and {count} scene(s) in {path.with_suffix('')}{os.sep}")
         out.print(f"{len(written)} scenario(s) compiled, {errors} error(s)",
                   style="bold red" if errors else "bold green")
     sys.exit(1 if errors else 0)
 
 
-def _write_ir(results, out_dir: Path) -> list[Path]:
-    ready = [r for r in results if r.scenario is not None]
+def parse_levels(text: str) -> tuple[str, ...]:
+    """``L0,L2`` -> ("L0", "L2"); anything else is a usage error."""
+    levels = tuple(dict.fromkeys(part.strip().upper() for part in text.split(",") if part.strip()))
+    bad = [level for level in levels if level not in ("L0", "L1", "L2")]
+    if bad or not levels:
+        raise click.BadParameter(f"expected levels among L0, L1, L2 (e.g. L0,L2), got {text!r}")
+    return levels
+
+
+def parse_seeds(text: str) -> tuple[int, ...]:
+    """``0-2,7`` -> (0, 1, 2, 7); anything else is a usage error."""
+    seeds: list[int] = []
+    try:
+        for part in (p.strip() for p in text.split(",")):
+            first, _, last = part.partition("-")
+            low, high = int(first), int(last) if last else int(first)
+            if low < 0 or high < low or high - low >= 10_000:
+                raise ValueError(part)
+            seeds.extend(range(low, high + 1))
+    except ValueError:
+        raise click.BadParameter(f"expected seeds such as 0, 0-4 or 0,3,7-9, got {text!r}") from None
+    return tuple(dict.fromkeys(seeds))
+
+
+def _compile_scenes(results, levels: Sequence[str], seeds: Sequence[int],
+                    roots: Sequence[Path]) -> dict[str, list[tuple[str, str]]]:
+    """Each scenario's scene files (name, JSON). A scenario whose layouts cannot be generated
+    gets a diagnostic in its result instead, so that nothing of it is written."""
+    from .compiler.scene import LoweringError
+    from .compiler.variants import generate_variant, lowering_diagnostic
+
+    scenes: dict[str, list[tuple[str, str]]] = {}
+    for result in results:
+        if result.scenario is None:
+            continue
+        try:
+            scenes[result.path] = [
+                (f"scene_{level}_s{seed}.json",
+                 generate_variant(result.scenario, level, seed, allowed_roots=roots).scene.model_dump_json() + "\n")
+                for level in levels for seed in seeds]
+        except LoweringError as error:
+            result.diagnostics.append(lowering_diagnostic(error, result.sources.get(error.source.file)))
+    return scenes
+
+
+def _write_ir(results, out_dir: Path, scenes: dict[str, list[tuple[str, str]]]) -> list[tuple[Path, int]]:
+    """Write each scenario's scenes, then its IR; return (IR path, number of scenes) each."""
+    ready = [r for r in results if r.scenario is not None and r.ok]
     names: dict[str, str] = {}
     for result in ready:
         other = names.setdefault(result.scenario.name, result.path)
@@ -162,9 +215,13 @@ def _write_ir(results, out_dir: Path) -> list[Path]:
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
     for result in ready:
+        folder = out_dir / result.scenario.name
+        folder.mkdir(exist_ok=True)
+        for name, text in scenes.get(result.path, ()):
+            write_atomic(folder / name, text)
         target = out_dir / f"{result.scenario.name}.json"
         write_atomic(target, result.scenario.model_dump_json(indent=2) + "\n")
-        written.append(target)
+        written.append((target, len(scenes.get(result.path, ()))))
     return written
 
 
@@ -189,6 +246,46 @@ def schema(indent: int) -> None:
     from .dsl.models import ir_json_schema
 
     click.echo(json.dumps(ir_json_schema(), indent=indent))
+
+
+@main.command()
+@click.argument("path", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@_root_option
+@click.option("--level", type=click.Choice(["L0", "L1", "L2"]), default="L0", show_default=True,
+              help="Layout level to render.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Variant seed (L1, L2).")
+@click.option("-o", "--out", "out_path", type=click.Path(dir_okay=False, path_type=Path),
+              default=Path("preview.png"), show_default=True, help="PNG file to write.")
+@click.option("--shader", type=click.Choice(["minimal", "default", "rt"]), default="minimal",
+              show_default=True, help="Camera shader: minimal is fast, default is lit with shadows.")
+@click.option("--overlays/--no-overlays", default=True, show_default=True,
+              help="Draw hazard regions, hard limits and warning bands into the scene.")
+def preview(path: Path, roots: tuple[Path, ...], level: str, seed: int, out_path: Path,
+            shader: str, overlays: bool) -> None:
+    """Render a scenario's cameras and a top-down view, with safety overlays, as one PNG."""
+    results = _load_all((path,), roots)
+    errors, _ = _report(results, "full", quiet=True)
+    err = _console(stderr=True)
+    scenario = results[0].scenario
+    if errors or scenario is None:
+        if not errors:
+            err.print(f"[bold red]error:[/bold red] {path} is abstract (a base for other "
+                      "scenarios); preview a scenario that extends it")
+        sys.exit(1)
+    from .compiler.scene import LoweringError
+    from .sim.preview import layout, render_preview
+    from .sim.render import RenderUnavailable
+
+    try:
+        scenario, scene = layout(scenario, level, seed)
+        image = render_preview(scenario, scene, overlays=overlays, shader=shader)
+    except (LoweringError, ValueError, RenderUnavailable) as problem:
+        err.print(f"[bold red]error:[/bold red] {problem}")
+        sys.exit(1)
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    image.save(out_path)
+    _console().print(f"[green]wrote[/green] {out_path} ({image.width}x{image.height}, "
+                     f"{scene.scenario} {level} seed {seed})")
 
 
 def run(argv: Iterable[str] | None = None) -> int:
