@@ -3,7 +3,7 @@
 Importing this package does not import SAPIEN; the modules that need it import it
 inside their functions, so ``fsvla check`` and spec-only code stay cheap.
 
-- :func:`build` (``fsvla.sim.build``): a SceneSpec to a SAPIEN scene, a :class:`BuiltScene`.
+- :func:`build` (in ``fsvla.sim.builder``): a SceneSpec to a SAPIEN scene, a :class:`BuiltScene`.
 - ``fsvla.sim.render``: the Vulkan device, cameras, lights (:class:`RenderUnavailable`).
 - ``fsvla.sim.overlays`` and ``fsvla.sim.preview``: safety overlays, ``fsvla preview``.
 - ``fsvla.sim.robot``: embodiments as PD-driven articulations (:func:`load_robot`).
@@ -11,7 +11,7 @@ inside their functions, so ``fsvla check`` and spec-only code stay cheap.
 
 from __future__ import annotations
 
-from .build import BuiltScene, build
+from .builder import BuiltScene, build
 from .render import RenderUnavailable, render_available
 
 __all__ = ["BuiltScene", "RenderUnavailable", "build", "render_available"]

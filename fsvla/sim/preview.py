@@ -83,7 +83,7 @@ def render_preview(scenario: Scenario, spec: SceneSpec, *, overlays: bool = True
     the spec plus :func:`top_down_camera`, overlays drawn when ``overlays``.
 
     Raises :class:`fsvla.sim.render.RenderUnavailable` without a Vulkan device."""
-    from .build import build
+    from .builder import build
     from .render import mount_camera
 
     built = build(spec, render=True, shader=shader, shadows=shadows)

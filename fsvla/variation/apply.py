@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.sim.build import BuiltScene
+from fsvla.sim.builder import BuiltScene
 
 from .vision import CameraShift, Patch, VisionPerturbation
 

@@ -57,7 +57,7 @@ def test_stove_overlays(stove) -> None:
     assert warn.inner == pytest.approx(0.06) and warn.outer == pytest.approx(0.10)
     assert ("stove#2", "hard") in kinds and ("stove#2", "warn") in kinds
     region = kinds[("stove", "region")].outline
-    assert region.center == pytest.approx((0.25, 0.0)) and region.half == pytest.approx((0.09, 0.09))
+    assert region.center == pytest.approx((0.30, 0.0)) and region.half == pytest.approx((0.09, 0.09))
     for overlay in overlays:
         vertices, faces = overlay.mesh()
         assert faces.max() < len(vertices) and vertices[:, 2].min() > 0.002  # above the marker

@@ -60,7 +60,7 @@ def test_unknown_level_is_refused(stove) -> None:
 @pytest.mark.render
 def test_v4_changes_pictures_but_not_physics(stove, render_device) -> None:
     from fsvla.compiler.scene import lower_scene
-    from fsvla.sim.build import build
+    from fsvla.sim.builder import build
     from fsvla.variation.apply import VisionApplier
 
     spec = lower_scene(stove)
@@ -85,7 +85,7 @@ def test_v4_changes_pictures_but_not_physics(stove, render_device) -> None:
 @pytest.mark.render
 def test_restore_returns_to_v0(stove, render_device) -> None:
     from fsvla.compiler.scene import lower_scene
-    from fsvla.sim.build import build
+    from fsvla.sim.builder import build
     from fsvla.variation.apply import VisionApplier
 
     built = build(lower_scene(stove), render=True)

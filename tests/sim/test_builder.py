@@ -149,7 +149,7 @@ def test_render_true_without_device_fails_clearly() -> None:
     RenderUnavailable naming the installer, and render=None falls back to physics only."""
     probe = (
         "from fsvla.compiler.scene import PhysicsSpec\n"
-        "from fsvla.sim.build import _has_render, _new_scene\n"
+        "from fsvla.sim.builder import _has_render, _new_scene\n"
         "from fsvla.sim.render import RenderUnavailable\n"
         "try:\n"
         "    _new_scene(PhysicsSpec(), True)\n"
