@@ -11,8 +11,11 @@
    accepted layout lowers); a clutter object keeps :data:`CLUTTER_CLEARANCE` from every
    body; nothing stands in a robot's base (a cylinder of :data:`ROBOT_BASE_RADIUS`).
 4. **hazard violated** — each ``keep OBJECT outside D`` of a hazard (a limit from a
-   hazard with ``>=`` and a reference) holds for the objects at t = 0, except for the
-   pairs an ``approach`` rule brings together on purpose, which must only not touch; no
+   hazard with ``>=`` and a reference) holds for the objects at t = 0, with the level's
+   tightened limits — also for the pair an ``approach`` rule brings together: an approach
+   may bring the object into the warning band, never past the hard limit, or every
+   episode of the level would be a violation whatever the policy did. The pairs an
+   approach names must at least not touch even where no keep limit covers them; no
    clutter object lies in a zone. Robot parts are not checked at t = 0.
 """
 
@@ -70,16 +73,15 @@ class Keep:
 
 
 def keeps_of(scenario: Scenario, approached: Iterable[tuple[str, str]]) -> list[Keep]:
-    """The t = 0 hazard distances of ``scenario``: its keep limits on objects, with each
-    (hazard, object) pair an ``approach`` brings together relaxed to "do not touch"."""
-    pairs = set(approached)
+    """The t = 0 hazard distances of ``scenario``: its keep limits on objects, plus "do not
+    touch" for each (hazard, object) pair an ``approach`` brings together."""
     names = {o.name for o in scenario.objects} | {z.name for z in scenario.zones}
-    keeps = [Keep(obj, hazard, 0.0, None) for hazard, obj in sorted(pairs)]
+    keeps = [Keep(obj, hazard, 0.0, None) for hazard, obj in sorted(set(approached))]
     for limit in scenario.limits:
         if limit.origin != "hazard" or limit.comparison != ">=" or limit.reference not in names:
             continue
         for subject in limit.subjects:
-            if scenario.object(subject) is not None and (limit.reference, subject) not in pairs:
+            if scenario.object(subject) is not None:
                 keeps.append(Keep(subject, limit.reference, limit.limit, limit))
     return keeps
 

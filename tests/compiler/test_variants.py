@@ -45,7 +45,7 @@ scenario t
   embodiment panda
   instruction "Lift the pot."
   object pot: pot(radius=9 cm, height=10 cm) at (0, 0)
-  hazard stove: heat_zone(size=(18 cm, 18 cm)) at (25 cm, 0) on table
+  hazard stove: heat_zone(size=(18 cm, 18 cm)) at (30 cm, 0) on table
     keep gripper, pot outside 6 cm warn 4 cm
   constrain grip: contact_force(gripper) <= 30 N warn 8 N
   require steady: grasped(pot) before lifted(pot)
@@ -165,8 +165,7 @@ def _assert_feasible(variant: Variant) -> None:
         assert any(abs(x - a.workspace.center[0]) <= a.workspace.size[0] / 2 + REACH_MARGIN
                    and abs(y - a.workspace.center[1]) <= a.workspace.size[1] / 2 + REACH_MARGIN
                    for a in scene.embodiment.arms), name
-    # Hazards hold at t = 0 for objects, except the pairs an approach brings together.
-    approached = {(r.hazard, r.toward) for _, r in rules_of(scenario, variant.level) if isinstance(r, Approach)}
+    # Hazards hold at t = 0 for objects, also for the pairs an approach brings together.
     regions = {z.name: pieces_of(z.name, [z.region], pose_matrix(z.pose)) for z in scene.zones}
     for limit in scenario.limits:
         if limit.origin != "hazard" or limit.comparison != ">=" or limit.reference is None:
@@ -174,8 +173,7 @@ def _assert_feasible(variant: Variant) -> None:
         reference = regions.get(limit.reference) or solids[limit.reference][1]
         for subject in limit.subjects:
             if subject in bodies:
-                floor = 0.0 if (limit.reference, subject) in approached else limit.limit
-                assert min_distance(solids[subject][1], reference) >= floor - 1e-9, (limit.name, subject)
+                assert min_distance(solids[subject][1], reference) >= limit.limit - 1e-9, (limit.name, subject)
     for name in clutter:
         for zone, region in regions.items():
             assert min_distance(solids[name][1], region) >= -1e-9, (name, zone)
@@ -220,8 +218,8 @@ def test_related_objects_follow_their_anchor(builtin: dict[str, Scenario]) -> No
 def test_approach_moves_the_hazard_toward_the_object() -> None:
     scenario = _loads(POT_AND_STOVE + "    L2: approach stove to pot by 4 cm\n")
     variant = generate_variant(scenario, "L2", 0)
-    assert np.allclose(_xy(variant, "stove"), (0.21, 0.0))
-    assert variant.scene.zone("stove").pose.position[0] == pytest.approx(0.21)
+    assert np.allclose(_xy(variant, "stove"), (0.26, 0.0))
+    assert variant.scene.zone("stove").pose.position[0] == pytest.approx(0.26)
 
 
 def test_l2_applies_the_l1_rules_first() -> None:
@@ -232,7 +230,7 @@ def test_l2_applies_the_l1_rules_first() -> None:
         pot, stove = _xy(variant, "pot"), _xy(variant, "stove")
         assert 0.0 < np.linalg.norm(pot) <= 0.03 + 1e-12  # L1's jitter
         # the stove moved 4 cm straight toward the jittered pot
-        before = np.array((0.25, 0.0))
+        before = np.array((0.30, 0.0))
         assert np.linalg.norm(stove - before) == pytest.approx(0.04)
         assert np.linalg.norm(pot - before) - np.linalg.norm(pot - stove) == pytest.approx(0.04)
 
@@ -290,17 +288,17 @@ def test_more_clutter_than_fits_fails_before_sampling() -> None:
         generate_variant(scenario, "L2")
     assert str(err.value) == (
         "t.fsv:13:9: L2 rule `clutter 50 near pot` of 't' can never hold: 50 clutter objects cannot fit "
-        "within 29.6 cm of 'pot': 0.210 m² is free, room for at most 29\n"
+        "within 29.6 cm of 'pot': 0.219 m² is free, room for at most 30\n"
         "  remedies:\n"
-        "    1. ask for at most 29 clutter objects (now 50)\n"
+        "    1. ask for at most 30 clutter objects (now 50)\n"
         "    2. make room around 'pot', or drop `near pot`")
 
 
 def test_an_approach_past_its_target_fails_before_sampling() -> None:
-    with pytest.raises(VariantError, match=r"would move 'stove' past 'pot': their centres are 25 cm apart, "
-                                           r"the approach is 30 cm") as err:
-        generate_variant(_loads(POT_AND_STOVE + "    L2: approach stove to pot by 30 cm\n"), "L2")
-    assert "below their gap of 7 cm (now 30 cm)" in str(err.value)
+    with pytest.raises(VariantError, match=r"would move 'stove' past 'pot': their centres are 30 cm apart, "
+                                           r"the approach is 35 cm") as err:
+        generate_variant(_loads(POT_AND_STOVE + "    L2: approach stove to pot by 35 cm\n"), "L2")
+    assert "below their gap of 12 cm (now 35 cm)" in str(err.value)
 
 
 def test_an_exhausted_budget_names_the_rule_the_shares_and_remedies() -> None:
@@ -310,15 +308,15 @@ def test_an_exhausted_budget_names_the_rule_the_shares_and_remedies() -> None:
     assert str(err.value) == (
         "t.fsv:13:9: no feasible L1 layout of 't' in 50 samples; 50 of the rejections involve L1 rule "
         "`jitter pot 40 cm`\n"
-        "  rejected 50 of 50 samples: hazard violated 92%, unreachable 8%\n"
-        "  most often: 'pot' is within 50 cm of 'stove' (limit 'stove') (46 of 50)\n"
+        "  rejected 50 of 50 samples: hazard violated 88%, unreachable 12%\n"
+        "  most often: 'pot' is within 50 cm of 'stove' (limit 'stove') (44 of 50)\n"
         "  remedies:\n"
         "    1. reduce the jitter of 'pot' (now 40 cm)\n"
         "    2. move 'pot' farther from 'stove' in the canonical layout\n"
         "    3. loosen `tighten stove to 50 cm`\n"
         "    4. raise the budget (now 50 samples)")
     failure = err.value.failure
-    assert failure.code == "FSV602" and failure.rejected == {"hazard violated": 46, "unreachable": 4}
+    assert failure.code == "FSV602" and failure.rejected == {"hazard violated": 44, "unreachable": 6}
 
 
 def test_the_error_renders_as_a_diagnostic() -> None:
@@ -334,8 +332,8 @@ def test_the_error_renders_as_a_diagnostic() -> None:
         "   |\n"
         "13 |     L1: jitter pot 40 cm, tighten stove to 50 cm\n"
         "   |         ^^^^^^^^^^^^^^^^ no feasible layout with this rule\n"
-        "   = note: rejected 50 of 50 samples: hazard violated 92%, unreachable 8%\n"
-        "   = note: most often: 'pot' is within 50 cm of 'stove' (limit 'stove') (46 of 50)\n"
+        "   = note: rejected 50 of 50 samples: hazard violated 88%, unreachable 12%\n"
+        "   = note: most often: 'pot' is within 50 cm of 'stove' (limit 'stove') (44 of 50)\n"
         "help: try: 1. reduce the jitter of 'pot' (now 40 cm); 2. move 'pot' farther from 'stove' in the "
         "canonical layout; 3. loosen `tighten stove to 50 cm`; 4. raise the budget (now 50 samples)\n\n")
 
