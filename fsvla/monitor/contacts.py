@@ -1,0 +1,113 @@
+"""What contact data the monitor reads, and when it can skip reading them.
+
+:func:`contact_plan` derives, from the force and ``untouched`` channels, which free
+bodies get a velocity-based net force (and torque) every substep and which contact pairs
+the per-substep scan keeps; :func:`predicate_filter` the pairs the contact predicates
+read at a step's last substep. :class:`ContactGate` turns a scan off for the next
+control step while no robot link is within :data:`CONTACT_GATE` of a body its pairs
+could touch (see ``fsvla.monitor.probe``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from fsvla.compiler.monitor import MonitorSpec
+from fsvla.compiler.scene import SceneSpec
+from fsvla.dsl.models import AllOf, AnyOf, Not, Predicate
+
+from .geometry import SceneGeometry
+from .layout import Layout
+from .predicates import CONTACT_PREDICATES
+from .probe import ContactFilter
+
+#: Broad-phase distance (m) within which robot links' contacts are scanned.
+CONTACT_GATE = 0.1
+FORCE_METRICS = frozenset({"contact_force", "contact_torque"})
+
+
+def contact_plan(spec: MonitorSpec, layout: Layout, scene_spec: SceneSpec) -> tuple[
+        set[str], set[str], ContactFilter]:
+    """(free bodies, torque frames, per-substep filter) the force and untouched channels need."""
+    static = {b.name for b in scene_spec.bodies if b.is_static}
+    free, torque, any_pair, robot_pairs = set(), set(), set(), set()
+    for ch in spec.channels:
+        if ch.metric in FORCE_METRICS:
+            for subject in ch.subjects:
+                frames = layout.frames(subject)
+                if ch.metric == "contact_torque":
+                    torque |= frames
+                body = layout.bodies.get(subject)
+                if body is not None and not body.articulated and subject not in static:
+                    free |= frames
+                    robot_pairs |= frames
+                else:
+                    any_pair |= frames
+        elif ch.metric == "untouched" and ch.reference in layout.bodies:
+            robot_pairs |= layout.frames(ch.reference)
+    return free, torque, ContactFilter(any_pair=frozenset(any_pair), robot_pairs=frozenset(robot_pairs))
+
+
+def predicate_filter(spec: MonitorSpec, layout: Layout) -> ContactFilter:
+    """The last-substep contacts the contact predicates read."""
+    any_pair, robot_pairs = set(), set()
+
+    def walk(c: Any) -> None:
+        if isinstance(c, Predicate):
+            if c.name not in CONTACT_PREDICATES:
+                return
+            bodies = [a for a in c.args if a in layout.bodies]
+            for a in bodies:
+                robot_pairs.update(layout.frames(a))
+            if c.name == "touching" and len(bodies) == 2:
+                any_pair.update(layout.frames(bodies[0]))
+        elif isinstance(c, (AllOf, AnyOf)):
+            for item in c.items:
+                walk(item)
+        elif isinstance(c, Not):
+            walk(c.item)
+
+    walk(spec.success.condition)
+    for r in spec.requirements:
+        walk(r.first)
+        walk(r.then)
+    return ContactFilter(any_pair=frozenset(any_pair), robot_pairs=frozenset(robot_pairs))
+
+
+class ContactGate:
+    """Whether the per-substep scan and the predicates' contact reading can find anything
+    in the next control step: one broad-phase matrix of robot-link pieces against body
+    pieces, read through masks. A filter that counts every contact of a non-robot frame
+    is never gated."""
+
+    def __init__(self, geometry: SceneGeometry, scan: ContactFilter, last: ContactFilter):
+        self.geometry = geometry
+        robot = frozenset(f for f in geometry.frames if f.startswith("@"))
+        self.rows, self.cols = robot, frozenset(f for f in geometry.frames if not f.startswith(("@", "zone:")))
+        ia, ib = geometry.pieces(self.rows), geometry.pieces(self.cols)
+        robot_any = frozenset(f for f in scan.any_pair if f.startswith("@"))
+        self.scan_always = bool(scan.any_pair - robot_any) or (bool(scan) and not len(ia))
+        self.last_always = bool(last.any_pair) or (bool(last) and not len(ia))
+        self.scan_rows = np.isin(ia, geometry.pieces(robot_any))
+        self.scan_cols = np.isin(ib, geometry.pieces(scan.robot_pairs))
+        self.last_cols = np.isin(ib, geometry.pieces(last.robot_pairs))
+        self.wants_scan, self.wants_last = bool(scan), bool(last)
+        self._answer: tuple[int, tuple[bool, bool]] | None = None
+
+    def update(self) -> tuple[bool, bool]:
+        """(scan substeps, read the last substep's contacts) for the next control step."""
+        version = self.geometry.version(self.rows) + self.geometry.version(self.cols)
+        if self._answer is not None and self._answer[0] == version:
+            return self._answer[1]  # nothing moved
+        near = self.geometry.near(self.rows, self.cols, CONTACT_GATE)
+        scan = self.scan_always or (self.wants_scan and bool(near[self.scan_rows].any()
+                                                             or near[:, self.scan_cols].any()))
+        last = self.last_always or (self.wants_last and bool(near[:, self.last_cols].any()))
+        self._answer = (version, (scan, last))
+        return scan, last
+
+
+
+__all__ = ["CONTACT_GATE", "FORCE_METRICS", "ContactGate", "contact_plan", "predicate_filter"]

@@ -1,0 +1,245 @@
+"""The success and precondition predicates of ``fsvla.dsl.catalog.PREDICATES``, evaluated on a
+:class:`WorldState` whose poses are in the :class:`SceneGeometry`.
+
+=========  ======================================================================================
+grasped    at least two finger links of the gripper (of the named arm, else of any arm) touch
+           the object (one, for a gripper with a single finger link)
+released   no link of any gripper touches the object
+lifted     the object's lowest point is at least ``by`` above its lowest point at reset
+opened     the first articulated part is open by at least ``fraction`` of its joint range
+closed     ... by at most ``fraction``
+inside     the first object's centre (of its bounds) is inside the second's cavity (rigid
+           containers), a moving part's link bounds or its own bounds (articulated), or its
+           bounds (anything else)
+on         the first object's centre lies over the second's footprint, its lowest point is
+           within ON_TOLERANCE of the second's top surface, and their geometry is within
+           ON_TOLERANCE
+upright    tilt (angle of the object's +z to the world's) at most ``within``
+tilted     tilt at least ``by``
+aligned    the entities' reference points (a robot part: its end-effector link origin; a body:
+           its bounds' centre; otherwise the centre of the geometry's bounds) within ``within``
+touching   in contact this step (a zone: geometry distance <= 0)
+near       geometry distance at most ``within``
+pressed    the grippers push the object down (force z < -PRESS_FORCE) in the last substep
+=========  ======================================================================================
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from fsvla.compiler.assets.model import Shape
+from fsvla.compiler.collision import pose_matrix
+from fsvla.compiler.monitor import MonitorSpec
+from fsvla.dsl.catalog import PREDICATES
+from fsvla.dsl.models import AllOf, AnyOf, Condition, Not, Predicate
+
+from .channels import tilt_of
+from .geometry import SceneGeometry
+from .layout import Layout
+from .state import WorldState
+
+ON_TOLERANCE = 0.01  # m
+PRESS_FORCE = 0.1  # N
+TOUCH_DISTANCE = 0.001  # m: "touching" by geometry, where no contacts were read
+
+#: Predicates that read contacts: the monitor reads the last substep's contacts for them.
+CONTACT_PREDICATES = frozenset({"grasped", "released", "touching", "pressed"})
+
+
+class Scope:
+    """What a predicate reads: the state, the layout and the posed geometry."""
+
+    def __init__(self, state: WorldState, layout: Layout, geometry: SceneGeometry):
+        self.state, self.layout, self.geo = state, layout, geometry
+
+    def frames(self, name: str) -> frozenset[str]:
+        return self.layout.frames(name)
+
+    def pose(self, frame: str) -> np.ndarray:
+        return self.state.poses[frame] if frame in self.state.poses else self.geo.pose(frame)
+
+    def root_pose(self, body: str) -> np.ndarray:
+        return self.pose(self.layout.bodies[body].root_frame)
+
+    def touching(self, a: frozenset[str], b: frozenset[str]) -> bool:
+        if self.state.contacts_read:
+            return self.state.touching(a, b)
+        return self.geo.distance(a, b) <= TOUCH_DISTANCE
+
+    def centre(self, body: str) -> np.ndarray:
+        lo, hi = self.layout.bodies[body].bounds
+        pose = self.root_pose(body)
+        return pose[:3, :3] @ ((lo + hi) / 2.0) + pose[:3, 3]
+
+    def point(self, entity: str) -> np.ndarray:
+        frame = self.layout.reference_frames.get(entity)
+        if frame is not None:
+            return self.pose(frame)[:3, 3]
+        if entity in self.layout.bodies:
+            return self.centre(entity)
+        bounds = self.geo.bounds(self.frames(entity))
+        return np.zeros(3) if bounds is None else (bounds[0] + bounds[1]) / 2.0
+
+    def lowest(self, body: str) -> float:
+        bounds = self.geo.bounds(self.frames(body))
+        return float(bounds[0][2]) if bounds is not None else float(self.root_pose(body)[2, 3])
+
+
+def _point_in_shape(point: np.ndarray, shape: Shape) -> bool:
+    m = pose_matrix(shape.pose)
+    p = (point - m[:3, 3]) @ m[:3, :3]
+    if shape.type == "box":
+        return bool(np.all(np.abs(p) <= np.asarray(shape.half_size)))
+    if shape.type == "cylinder":
+        return bool(np.hypot(p[0], p[1]) <= shape.radius and abs(p[2]) <= shape.half_length)
+    if shape.type == "sphere":
+        return bool(np.linalg.norm(p) <= shape.radius)
+    if shape.type == "capsule":
+        z = np.clip(p[2], -shape.half_length, shape.half_length)
+        return bool(np.linalg.norm(p - np.array([0.0, 0.0, z])) <= shape.radius)
+    from fsvla.compiler.collision import shape_vertices
+
+    v = shape_vertices(shape)
+    return bool(np.all(p >= v.min(axis=0)) and np.all(p <= v.max(axis=0)))
+
+
+def _in_box(point: np.ndarray, pose: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
+    local = (point - pose[:3, 3]) @ pose[:3, :3]
+    return bool(np.all(local >= lo) and np.all(local <= hi))
+
+
+def _param(p: Predicate, name: str) -> float:
+    value = p.params.get(name, PREDICATES[p.name].param(name).default)  # type: ignore[union-attr]
+    return float(value)  # type: ignore[arg-type]
+
+
+def _grasped(p: Predicate, s: Scope) -> bool:
+    obj = s.frames(p.args[0])
+    arms = [s.layout.arms[p.args[1]]] if len(p.args) > 1 else list(s.layout.arms.values())
+    for arm in arms:
+        touching = sum(1 for f in arm.fingers if s.touching(frozenset({f}), obj))
+        if touching >= min(2, len(arm.fingers)):
+            return True
+    return False
+
+
+def _released(p: Predicate, s: Scope) -> bool:
+    return not s.touching(s.layout.grippers, s.frames(p.args[0]))
+
+
+def _lifted(p: Predicate, s: Scope) -> bool:
+    obj = p.args[0]
+    start = s.layout.initial_low.get(obj, s.lowest(obj))
+    return s.lowest(obj) >= start + _param(p, "by")
+
+
+def _open_fraction(p: Predicate, s: Scope) -> float:
+    body = s.layout.bodies[p.args[0]]
+    if not body.parts:
+        return 0.0
+    part = body.parts[0]
+    span = part.upper - part.lower
+    if span == 0.0:
+        return 0.0
+    q = s.state.joints.get(part.joint, part.lower)
+    return abs(q - part.lower) / abs(span)
+
+
+def _inside(p: Predicate, s: Scope) -> bool:
+    point = s.centre(p.args[0])
+    outer = s.layout.bodies[p.args[1]]
+    if outer.cavity is not None:
+        return _point_in_shape(_to_local(point, s.root_pose(outer.name)), outer.cavity)
+    for part in outer.parts:
+        if part.link_frame in outer.link_bounds:
+            lo, hi = outer.link_bounds[part.link_frame]
+            if _in_box(point, s.pose(part.link_frame), lo, hi):
+                return True
+    return _in_box(point, s.root_pose(outer.name), *outer.bounds)
+
+
+def _to_local(point: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    return (point - pose[:3, 3]) @ pose[:3, :3]
+
+
+def _on(p: Predicate, s: Scope) -> bool:
+    top, base = p.args
+    info = s.layout.bodies[base]
+    pose = s.root_pose(base)
+    local = _to_local(s.centre(top), pose)
+    (x0, y0), (x1, y1) = info.footprint
+    if not (x0 <= local[0] <= x1 and y0 <= local[1] <= y1):
+        return False
+    surface = (pose @ np.array([local[0], local[1], info.top, 1.0]))[2]
+    if abs(s.lowest(top) - surface) > ON_TOLERANCE:
+        return False
+    return s.geo.distance(s.frames(top), s.frames(base)) <= ON_TOLERANCE
+
+
+def _touching(p: Predicate, s: Scope) -> bool:
+    a, b = s.frames(p.args[0]), s.frames(p.args[1])
+    if p.args[0] in s.layout.zones or p.args[1] in s.layout.zones:
+        return s.geo.distance(a, b) <= 0.0
+    return s.touching(a, b)
+
+
+def _pressed(p: Predicate, s: Scope) -> bool:
+    force = s.state.force_on(s.frames(p.args[0]), s.layout.grippers)
+    return bool(force[2] < -PRESS_FORCE)
+
+
+Evaluate = Callable[[Predicate, Scope], bool]
+
+EVALUATORS: dict[str, Evaluate] = {
+    "grasped": _grasped,
+    "released": _released,
+    "lifted": _lifted,
+    "opened": lambda p, s: _open_fraction(p, s) >= _param(p, "fraction"),
+    "closed": lambda p, s: _open_fraction(p, s) <= _param(p, "fraction"),
+    "inside": _inside,
+    "on": _on,
+    "upright": lambda p, s: tilt_of(s.root_pose(p.args[0])) <= _param(p, "within"),
+    "tilted": lambda p, s: tilt_of(s.root_pose(p.args[0])) >= _param(p, "by"),
+    "aligned": lambda p, s: float(np.linalg.norm(s.point(p.args[0]) - s.point(p.args[1]))) <= _param(p, "within"),
+    "touching": _touching,
+    "near": lambda p, s: s.geo.distance(s.frames(p.args[0]), s.frames(p.args[1])) <= _param(p, "within"),
+    "pressed": _pressed,
+}
+assert set(EVALUATORS) == set(PREDICATES), "every catalog predicate needs an evaluator"
+
+
+def holds(condition: Condition, scope: Scope) -> bool:
+    """Whether a condition tree holds in the scope's state."""
+    if isinstance(condition, Predicate):
+        return EVALUATORS[condition.name](condition, scope)
+    if isinstance(condition, AllOf):
+        return all(holds(item, scope) for item in condition.items)
+    if isinstance(condition, AnyOf):
+        return any(holds(item, scope) for item in condition.items)
+    if isinstance(condition, Not):
+        return not holds(condition.item, scope)
+    raise TypeError(f"not a condition: {condition!r}")
+
+
+def uses_contacts(spec: MonitorSpec) -> bool:
+    """Whether the spec's success condition or requirements use a contact predicate."""
+    used = predicate_names(spec.success.condition).union(
+        *(predicate_names(r.first) | predicate_names(r.then) for r in spec.requirements))
+    return bool(used & CONTACT_PREDICATES)
+
+
+def predicate_names(condition: Condition) -> set[str]:
+    if isinstance(condition, Predicate):
+        return {condition.name}
+    if isinstance(condition, (AllOf, AnyOf)):
+        return set().union(*(predicate_names(i) for i in condition.items))
+    if isinstance(condition, Not):
+        return predicate_names(condition.item)
+    return set()
+
+
+__all__ = ["CONTACT_PREDICATES", "EVALUATORS", "ON_TOLERANCE", "PRESS_FORCE", "Scope", "holds",
+           "predicate_names", "uses_contacts"]

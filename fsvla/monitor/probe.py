@@ -1,0 +1,239 @@
+"""Read a :class:`~fsvla.monitor.state.WorldState` from a SAPIEN scene.
+
+Python access to SAPIEN's contact points costs microseconds per point, and a resting
+object made of convex pieces has a dozen contacts with the table in every substep, so
+the probe reads forces two ways, both at **every** physics substep (a spike inside a
+control step is never missed):
+
+- **Net contact force on a free rigid body** (a dynamic, non-kinematic scene body),
+  from its velocity change over the substep: ``F = m (v' - v) / dt - m g`` and, about
+  its centre of mass, ``τ = I_w (ω' - ω) / dt + ω' × I_w ω'``. This equals the sum of
+  the contact impulses on it divided by the timestep (a landing, a knock), at the cost of
+  two velocity reads. It is recorded as the pair (body, ``"*"``).
+- **Per-pair contact forces** from ``scene.get_contacts()`` for the pairs a channel
+  needs (:class:`ContactFilter`): every pair of a watched robot link or articulated
+  link, and robot-link pairs of watched objects (a squeeze, whose net force is zero).
+  Contacts between two links of one robot are skipped. The scan runs in a control step
+  only while :attr:`Probe.scan` is set (the monitor clears it while no watched robot
+  link is near anything, see ``fsvla.monitor.monitor``).
+
+A contact's impulses act on its first body; the second gets their opposite.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .state import ContactMaxima, Matrix4, WorldState, link_frame, robot_frame
+
+#: The "other side" of a body's net contact force in ContactMaxima keys.
+NET = "*"
+
+
+def _rigid_component(entity: Any) -> Any:
+    import sapien
+
+    for component in entity.components:
+        if isinstance(component, sapien.physx.PhysxRigidBaseComponent):
+            return component
+    raise ValueError(f"entity {entity.name!r} has no rigid-body component")
+
+
+def components_of(bodies: Mapping[str, Any], articulations: Mapping[str, Any],
+                  robots: Mapping[str, Any]) -> dict[str, Any]:
+    """Frame name -> SAPIEN rigid component or link, for a built scene's parts."""
+    frames: dict[str, Any] = {}
+    for name, entity in bodies.items():
+        frames[name] = _rigid_component(entity)
+    for name, articulation in articulations.items():
+        for link in articulation.links:
+            frames[link_frame(name, link.name)] = link
+    for name, articulation in robots.items():
+        for link in articulation.links:
+            frames[robot_frame(name, link.name)] = link
+    return frames
+
+
+def _robot_of(frame: str | None) -> str | None:
+    return frame.split(":", 1)[0] if frame and frame.startswith("@") else None
+
+
+@dataclass(frozen=True)
+class ContactFilter:
+    """Which contact pairs the per-substep scan folds into the maxima."""
+
+    any_pair: frozenset[str] = frozenset()  # frames whose every contact counts
+    robot_pairs: frozenset[str] = frozenset()  # frames whose contacts with a robot link count
+
+    def __bool__(self) -> bool:
+        return bool(self.any_pair or self.robot_pairs)
+
+    def wants(self, f0: str | None, f1: str | None) -> bool:
+        if f0 in self.any_pair or f1 in self.any_pair:
+            r0 = _robot_of(f0)
+            return r0 is None or r0 != _robot_of(f1)  # not a robot's own links
+        return ((f0 in self.robot_pairs and f1 is not None and f1[0] == "@")
+                or (f1 in self.robot_pairs and f0 is not None and f0[0] == "@"))
+
+
+class _FreeBody:
+    """Velocity-based net contact force and torque of one dynamic rigid body (plain floats:
+    numpy's per-call overhead would dominate these three-vectors)."""
+
+    def __init__(self, frame: str, component: Any, gravity: tuple[float, float, float], torque: bool):
+        self.frame, self.c, self.torque = frame, component, torque
+        self.mass = float(component.mass)
+        self.weight = tuple(self.mass * g for g in gravity)
+        self.inertia = tuple(float(v) for v in component.inertia)
+        self.cmass_q = tuple(component.cmass_local_pose.q.tolist())  # principal axes in the body frame
+        self.read()
+
+    def read(self) -> None:
+        self.v = self.c.linear_velocity.tolist()
+        self.w = self._body_omega() if self.torque else None
+
+    def _body_omega(self) -> list[float]:
+        """Angular velocity in the principal (centre-of-mass) frame."""
+        a1, b1, c1, d1 = self.c.entity_pose.q.tolist()
+        a2, b2, c2, d2 = self.cmass_q
+        w = a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2
+        x = a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2
+        y = a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2
+        z = a1 * d2 + b1 * c2 - c1 * b2 + d1 * a2
+        ox, oy, oz = self.c.angular_velocity.tolist()
+        # R^T ω for the unit quaternion (w, x, y, z)
+        return [(1 - 2 * (y * y + z * z)) * ox + 2 * (x * y + w * z) * oy + 2 * (x * z - w * y) * oz,
+                2 * (x * y - w * z) * ox + (1 - 2 * (x * x + z * z)) * oy + 2 * (y * z + w * x) * oz,
+                2 * (x * z + w * y) * ox + 2 * (y * z - w * x) * oy + (1 - 2 * (x * x + y * y)) * oz]
+
+    def record(self, maxima: ContactMaxima, inv_dt: float) -> None:
+        v = self.c.linear_velocity.tolist()
+        m = self.mass * inv_dt
+        fx, fy, fz = (m * (a - b) - g for a, b, g in zip(v, self.v, self.weight))
+        self.v = v
+        maxima.add_force(self.frame, NET, math.sqrt(fx * fx + fy * fy + fz * fz))
+        if self.torque:
+            w = self._body_omega()
+            ix, iy, iz = self.inertia
+            lx, ly, lz = ix * w[0], iy * w[1], iz * w[2]
+            tx = ix * (w[0] - self.w[0]) * inv_dt + w[1] * lz - w[2] * ly
+            ty = iy * (w[1] - self.w[1]) * inv_dt + w[2] * lx - w[0] * lz
+            tz = iz * (w[2] - self.w[2]) * inv_dt + w[0] * ly - w[1] * lx
+            self.w = w
+            maxima.add_torque(self.frame, NET, math.sqrt(tx * tx + ty * ty + tz * tz))
+
+
+class Probe:
+    """Reads contact forces per substep and a snapshot per control step."""
+
+    def __init__(self, scene: Any, timestep: float, components: Mapping[str, Any], *,
+                 pose_frames: Iterable[str] = (), free_bodies: Iterable[str] = (),
+                 torque_frames: Iterable[str] = (), scan: ContactFilter = ContactFilter(),
+                 last: ContactFilter = ContactFilter(),
+                 joints: Mapping[str, tuple[Any, int]] | None = None,
+                 gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)):
+        self._scene = scene
+        self._dt = float(timestep)
+        self.components = dict(components)
+        self._frame_of = {id(c): f for f, c in self.components.items()}
+        self._pose_frames = [(f, self.components[f]) for f in pose_frames if f in self.components]
+        self._torque = frozenset(torque_frames)
+        g = (float(gravity[0]), float(gravity[1]), float(gravity[2]))
+        self._free = [_FreeBody(f, self.components[f], g, f in self._torque) for f in free_bodies
+                      if f in self.components]
+        self._filter = scan
+        self._last = last
+        self._joints = dict(joints or {})  # "<body>:<joint>" -> (articulation, qpos index)
+        self.maxima = ContactMaxima()
+        self.scan = True  # the per-substep pair scan runs
+        self.read_last = True  # snapshot(contacts=True) reads the last substep's contacts
+
+    @property
+    def records_substeps(self) -> bool:
+        return bool(self._free) or bool(self._filter)
+
+    def frame_of(self, component: Any) -> str:
+        return self._frame_of.get(id(component)) or f"?{component.entity.name}"
+
+    def reset(self) -> None:
+        """Forget the maxima and re-read velocities (after the scene was reset)."""
+        self.maxima.clear()
+        for body in self._free:
+            body.read()
+
+    def record_substep(self) -> None:
+        """Fold the physics step just taken into the control step's maxima."""
+        inv_dt = 1.0 / self._dt
+        for body in self._free:
+            body.record(self.maxima, inv_dt)
+        if self.scan and self._filter:
+            self._scan(inv_dt)
+
+    def _scan(self, inv_dt: float) -> None:
+        frame_of, wants, maxima, torque = self._frame_of.get, self._filter.wants, self.maxima, self._torque
+        for contact in self._scene.get_contacts():
+            b0, b1 = contact.bodies
+            f0, f1 = frame_of(id(b0)), frame_of(id(b1))
+            if not wants(f0, f1):
+                continue
+            f0 = f0 or f"?{b0.entity.name}"
+            f1 = f1 or f"?{b1.entity.name}"
+            points = contact.points
+            impulse = sum((p.impulse for p in points), np.zeros(3))
+            magnitude = float(np.sqrt(impulse @ impulse)) * inv_dt
+            if magnitude <= 0.0:
+                continue
+            maxima.add_force(f0, f1, magnitude)
+            if f0 in torque:
+                maxima.add_torque(f0, f1, _torque_about(b0, points, inv_dt))
+            if f1 in torque:
+                maxima.add_torque(f1, f0, _torque_about(b1, points, inv_dt))
+
+    def last_contacts(self) -> dict[tuple[str, str], np.ndarray]:
+        """Force on the first frame by the second, for the wanted contacts of the last substep."""
+        forces: dict[tuple[str, str], np.ndarray] = {}
+        inv_dt = 1.0 / self._dt
+        frame_of, wants = self._frame_of.get, self._last.wants
+        for contact in self._scene.get_contacts():
+            b0, b1 = contact.bodies
+            f0, f1 = frame_of(id(b0)), frame_of(id(b1))
+            if not wants(f0, f1):
+                continue
+            f0 = f0 or f"?{b0.entity.name}"
+            f1 = f1 or f"?{b1.entity.name}"
+            force = sum((p.impulse for p in contact.points), np.zeros(3)) * inv_dt
+            forces[(f0, f1)] = forces.get((f0, f1), np.zeros(3)) + force
+            forces[(f1, f0)] = forces.get((f1, f0), np.zeros(3)) - force
+        return forces
+
+    def poses(self) -> dict[str, Matrix4]:
+        return {f: c.entity_pose.to_transformation_matrix() for f, c in self._pose_frames}
+
+    def snapshot(self, step: int, time: float, *, contacts: bool = False) -> WorldState:
+        """The world now, with the maxima recorded since the last snapshot (which are then
+        cleared); ``contacts`` also reads the last substep's wanted contact forces."""
+        joints = {k: float(a.get_qpos()[i]) for k, (a, i) in self._joints.items()}
+        state = WorldState(step=step, time=time, poses=self.poses(), joints=joints,
+                           contact_force=dict(self.maxima.force), contact_torque=dict(self.maxima.torque),
+                           last_contacts=self.last_contacts() if contacts and self.read_last else {},
+                           contacts_read=contacts or self.records_substeps)
+        self.maxima.clear()
+        return state
+
+
+def _torque_about(body: Any, points: Any, inv_dt: float) -> float:
+    """Magnitude of the contact torque on ``body`` (the contact's first body: sign +;
+    the magnitude is the same for the second) about its centre of mass."""
+    centre = np.asarray((body.entity_pose * body.cmass_local_pose).p, dtype=np.float64)
+    torque = np.zeros(3)
+    for p in points:
+        torque += np.cross(np.asarray(p.position) - centre, p.impulse)
+    return float(np.sqrt(torque @ torque)) * inv_dt
+
+
+__all__ = ["NET", "ContactFilter", "Probe", "components_of"]

@@ -1,0 +1,110 @@
+"""A plain snapshot of the world at the end of one control step.
+
+The probe (``fsvla.monitor.probe``) fills it from a SAPIEN scene; channels and predicates
+read only this, so they can be tested on hand-made snapshots with no simulator.
+
+Frames are named by string:
+
+- a rigid body: its name (``"mug"``);
+- a link of an articulated body: ``"<body>:<link>"`` (``"cabinet:drawer"``);
+- a robot link: ``"@<robot>:<link>"`` (``"@panda:panda_hand"``).
+
+Contact data are taken over the control step's physics substeps: ``contact_force`` holds,
+per unordered frame pair, the largest magnitude of the pair's total contact force in any
+substep (impulse / timestep), so a spike in a single substep is never missed;
+``contact_torque`` holds, per ordered pair (frame, other), the largest magnitude of the
+torque those contacts exert about the frame's centre of mass. ``last_contacts`` is the
+force on the first frame by the second in the step's last substep (both orders present).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+Matrix4 = NDArray[np.float64]
+Pair = tuple[str, str]
+
+
+def robot_frame(robot: str, link: str) -> str:
+    return f"@{robot}:{link}"
+
+
+def link_frame(body: str, link: str) -> str:
+    return f"{body}:{link}"
+
+
+def pair_key(a: str, b: str) -> Pair:
+    """The unordered key of a frame pair."""
+    return (a, b) if a <= b else (b, a)
+
+
+@dataclass
+class ContactMaxima:
+    """Running maxima over the substeps of one control step."""
+
+    force: dict[Pair, float] = field(default_factory=dict)  # unordered pair -> N
+    torque: dict[Pair, float] = field(default_factory=dict)  # (frame, other) -> Nm
+
+    def add_force(self, a: str, b: str, magnitude: float) -> None:
+        key = pair_key(a, b)
+        if magnitude > self.force.get(key, -1.0):
+            self.force[key] = magnitude
+
+    def add_torque(self, frame: str, other: str, magnitude: float) -> None:
+        key = (frame, other)
+        if magnitude > self.torque.get(key, -1.0):
+            self.torque[key] = magnitude
+
+    def clear(self) -> None:
+        self.force.clear()
+        self.torque.clear()
+
+
+@dataclass(frozen=True)
+class WorldState:
+    """The world at the end of control step ``step`` (time ``time`` s since reset)."""
+
+    step: int
+    time: float
+    poses: Mapping[str, Matrix4]  # frame -> 4x4 world pose
+    joints: Mapping[str, float] = field(default_factory=dict)  # "<body>:<joint>" -> position
+    contact_force: Mapping[Pair, float] = field(default_factory=dict)
+    contact_torque: Mapping[Pair, float] = field(default_factory=dict)
+    last_contacts: Mapping[Pair, NDArray[np.float64]] = field(default_factory=dict)
+    contacts_read: bool = False  # whether any contact data were read this step
+
+    def max_force(self, frames_a: frozenset[str], frames_b: frozenset[str] | None = None) -> float:
+        """Largest substep contact force between a frame of ``a`` and one of ``b``
+        (any frame outside ``a`` when ``b`` is None); 0 with no contact."""
+        best = 0.0
+        for (x, y), value in self.contact_force.items():
+            for s, o in ((x, y), (y, x)):
+                if s in frames_a and (o not in frames_a if frames_b is None else o in frames_b):
+                    best = max(best, value)
+        return best
+
+    def max_torque(self, frames: frozenset[str]) -> float:
+        """Largest substep contact torque on a frame of ``frames`` by a frame outside it."""
+        return max((v for (f, o), v in self.contact_torque.items() if f in frames and o not in frames),
+                   default=0.0)
+
+    def touching(self, frames_a: frozenset[str], frames_b: frozenset[str]) -> bool:
+        """Any contact between the groups in the step (any substep, or the last one)."""
+        if self.max_force(frames_a, frames_b) > 0.0:
+            return True
+        return any(a in frames_a and b in frames_b for a, b in self.last_contacts)
+
+    def force_on(self, frames: frozenset[str], by: frozenset[str]) -> NDArray[np.float64]:
+        """Total force on ``frames`` by ``by`` in the last substep."""
+        total = np.zeros(3)
+        for (a, b), force in self.last_contacts.items():
+            if a in frames and b in by:
+                total += force
+        return total
+
+
+__all__ = ["ContactMaxima", "Matrix4", "Pair", "WorldState", "link_frame", "pair_key", "robot_frame"]
