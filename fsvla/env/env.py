@@ -1,0 +1,221 @@
+"""The fsvla gymnasium environment: one scenario layout, a policy's actions, the monitor.
+
+``FsvlaEnv`` compiles a scenario's layout variant (level, seed) to a SceneSpec and a
+MonitorSpec, builds the SAPIEN scene (physics only unless images are asked for), and
+then, at every ``step``: validates the action (:mod:`fsvla.env.actions`), sets the drive
+targets, runs the physics substeps of one control step while the safety monitor samples
+each substep, and returns the observation, a sparse reward (1 when the success condition
+has held for its hold time, else 0), ``terminated`` on success (or on a hard violation
+when ``terminate_on_violation``), ``truncated`` at the scenario's horizon, and the
+monitor's report in ``info``. A hard violation does not end the episode by default: the
+paper keeps exposure running so CC and RET measure the whole episode.
+
+The benchmark coordinates are fixed at construction: the layout by ``level`` and
+``seed`` (L0–L2), the instruction by ``language`` (W0–W4) and the pictures by ``vision``
+(V0–V4), both drawn with the same ``seed`` (``fsvla.variation``). Vision levels change
+only rendered observations, so they need ``obs_mode="rgb"``. ``reset(seed=...)`` seeds nothing else (the simulation is deterministic),
+so the same seed and actions give the identical trace.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import gymnasium
+import numpy as np
+
+from fsvla.compiler.monitor import MonitorSpec, lower_monitor
+from fsvla.compiler.scene import Level, SceneSpec
+from fsvla.compiler.variants import generate_variant
+from fsvla.dsl.models import Scenario
+from fsvla.embodiments import load_embodiment
+from fsvla.library import ScenarioRef, load_scenario
+from fsvla.monitor import SafetyMonitor
+from fsvla.sim.builder import BuiltScene, build
+from fsvla.sim.kinematics import ArmKinematics
+from fsvla.variation.apply import VisionApplier
+from fsvla.variation.language import Instruction, instruction_for
+from fsvla.variation.vision import VisionPerturbation, perturbation_for
+
+from .actions import ActionCodec, ArmCommand, ArmLayout, ControlMode
+from .observations import assemble, check_instruction, observation_space, proprioception
+from .recording import EpisodeRecorder
+
+OBS_MODES = ("state", "rgb")
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """Everything that fixes an environment instance, echoed into every trace."""
+
+    scenario: str
+    level: Level
+    seed: int
+    language: str
+    vision: str
+    embodiment: str
+    obs_mode: str
+    control_mode: str
+    terminate_on_violation: bool
+    monitor: bool
+
+
+class FsvlaEnv(gymnasium.Env):
+    """A gymnasium environment for one scenario at one layout (level, seed)."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+
+    def __init__(
+        self,
+        scenario: ScenarioRef,
+        level: Level = "L0",
+        seed: int = 0,
+        embodiment: str | None = None,
+        obs_mode: str = "state",
+        control_mode: str = "joint_pos",
+        *,
+        language: str = "W0",
+        vision: str = "V0",
+        instruction: str | None = None,
+        terminate_on_violation: bool = False,
+        monitor: bool = True,
+        render_mode: str | None = None,
+    ) -> None:
+        if obs_mode not in OBS_MODES:
+            raise ValueError(f"obs_mode must be one of {', '.join(OBS_MODES)}, got {obs_mode!r}")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        self.render_mode = render_mode
+        source = load_scenario(scenario)
+        spec = load_embodiment(embodiment) if embodiment is not None else None
+        variant = generate_variant(source, level=level, seed=seed, embodiment=spec)
+        self.scenario: Scenario = variant.scenario
+        self.scene_spec: SceneSpec = variant.scene
+        self.monitor_spec: MonitorSpec = lower_monitor(variant.scenario, variant.scene)
+        self.config = EnvConfig(
+            scenario=source.name, level=level, seed=seed, language=language, vision=vision,
+            embodiment=self.scene_spec.embodiment.name, obs_mode=obs_mode,
+            control_mode=ControlMode(control_mode).value,
+            terminate_on_violation=terminate_on_violation, monitor=monitor)
+        # W and V are drawn from the source scenario (its digest seeds them), per layout seed.
+        self.language: Instruction = instruction_for(source, language, seed)  # type: ignore[arg-type]
+        self.vision: VisionPerturbation = perturbation_for(source, vision, seed)  # type: ignore[arg-type]
+        self.instruction = check_instruction(instruction if instruction is not None
+                                             else self.language.text)
+
+        wants_images = obs_mode == "rgb" or render_mode == "rgb_array"
+        self.built: BuiltScene = build(self.scene_spec, render=True if wants_images else False)
+        self.monitor = SafetyMonitor(self.monitor_spec, self.built) if monitor else None
+        self._vision: VisionApplier | None = None
+        if self.built.renders:
+            self._vision = VisionApplier(self.built)
+            self._vision.apply(self.vision)
+        elif vision != "V0":
+            raise ValueError(f"vision level {vision} changes only pictures; it needs "
+                             "obs_mode='rgb' (or render_mode='rgb_array')")
+
+        arms = list(self.built.robot.arms.values())
+        layouts = [_layout(arm) for arm in arms]
+        self.codec = ActionCodec(layouts, control_mode)
+        self._kinematics = ({arm.name: ArmKinematics(arm) for arm in arms}
+                            if self.codec.mode is ControlMode.EE_POSE else {})
+        self.action_space = self.codec.space()
+        self.observation_space = observation_space(
+            [v for layout in layouts for v in _finite(layout.lower, -np.pi)],
+            [v for layout in layouts for v in _finite(layout.upper, np.pi)],
+            len(arms), self.scene_spec.cameras, with_images=obs_mode == "rgb")
+        physics = self.scene_spec.physics
+        self.substeps = physics.substeps
+        self.control_dt = physics.control_dt
+        self.max_steps = max(1, round(self.scenario.horizon / self.control_dt))
+        self.recorder = EpisodeRecorder(self.monitor_spec, self.codec.labels)
+        self._t = 0
+
+    # -------------------------------------------------------------- gymnasium API
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        self.built.reset()
+        if self.monitor is not None:
+            self.monitor.reset()
+        self.recorder.start()
+        self._t = 0
+        info = {"step": 0, "max_steps": self.max_steps, "instruction": self.instruction}
+        return self._observe(), info
+
+    def step(self, action: Any):
+        commands = self.codec.decode(action)
+        ik_errors = self._apply(commands)
+        for _ in range(self.substeps):
+            self.built.step(1)
+            if self.monitor is not None:
+                self.monitor.record_substep()
+        self._t += 1
+        info: dict[str, Any] = {"step": self._t}
+        success = violation = False
+        if self.monitor is not None:
+            report = self.monitor.end_step()
+            success, violation = report.success, report.any_violation
+            info.update(report.info())
+            self.recorder.add(np.asarray(action, dtype=np.float64), report)
+        if ik_errors:
+            info["ik_error"] = ik_errors
+        terminated = success or (violation and self.config.terminate_on_violation)
+        truncated = not terminated and self._t >= self.max_steps
+        return self._observe(), float(success), terminated, truncated, info
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        views = self.built.render_views()
+        return np.concatenate(list(views.values()), axis=1) if views else None
+
+    def close(self) -> None:
+        self.built = None  # type: ignore[assignment]  # drop the SAPIEN scene
+
+    # -------------------------------------------------------------- traces
+    def episode_record(self):
+        """The episode so far: per-step margins, costs, states, actions (see recording)."""
+        return self.recorder.record()
+
+    # -------------------------------------------------------------- internals
+    def _apply(self, commands: tuple[ArmCommand, ...]) -> dict[str, float]:
+        """Set drive targets; returns the IK position error (m) of arms that missed."""
+        robot = self.built.robot
+        missed: dict[str, float] = {}
+        for command in commands:
+            arm = robot.arm(command.arm)
+            if command.joint_targets is not None:
+                arm.set_joint_targets(command.joint_targets)
+            else:
+                solution = self._kinematics[command.arm].inverse(
+                    tuple(command.tcp_position), tuple(command.tcp_quaternion),
+                    seed=arm.qpos(), restarts=2)
+                arm.set_joint_targets(solution.qpos)
+                if not solution.ok():
+                    missed[command.arm] = solution.position_error
+            arm.set_gripper_opening(command.gripper)
+        return missed
+
+    def _observe(self) -> dict[str, Any]:
+        images = None
+        if self.config.obs_mode == "rgb":
+            images = self.built.render_views()
+            if self._vision is not None:
+                images = self._vision.composite(images)
+        return assemble(proprioception(self.built.robot), self.instruction, images)
+
+
+def _finite(values: tuple[float, ...], bound: float) -> list[float]:
+    """Joint limits with an unlimited (continuous) joint bounded by ``bound`` times 100."""
+    return [v if np.isfinite(v) else 100.0 * bound for v in values]
+
+
+def _layout(arm) -> ArmLayout:  # noqa: ANN001 - a LoadedArm
+    joints = arm.articulation.active_joints
+    limits = [joints[i].limit[0] for i in arm.joint_indices]
+    return ArmLayout(arm.name, tuple(arm.spec.joints),
+                     tuple(float(lo) for lo, _ in limits), tuple(float(hi) for _, hi in limits))
+
+
+__all__ = ["EnvConfig", "FsvlaEnv", "OBS_MODES"]
