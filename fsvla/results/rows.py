@@ -1,0 +1,155 @@
+"""Between an episode's outcome, its ``episodes`` row and its :class:`EpisodeMetrics`.
+
+Scoring (:func:`score`): a completed episode is scored on all its steps. A faulted one
+is scored as a task failure (S = 0, whatever the success condition did) on the steps
+that ran, up to the first step with a non-finite margin (a simulator blow-up); if no
+step is left its row has NULL metrics. :func:`row_metrics` turns a row back into the
+:class:`EpisodeMetrics` that was computed, for :mod:`fsvla.metrics.aggregate`.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from datetime import datetime, timezone
+from typing import Any
+
+import numpy as np
+
+from fsvla.metrics.episode import EpisodeMetrics, episode_metrics
+from fsvla.metrics.trace import ChannelInfo, EpisodeMeta, EpisodeTrace
+from fsvla.results.models import EpisodeOutcome, EpisodeRow
+from fsvla.run.plan import EpisodeSpec
+
+_JSON_COLUMNS = {"perturbation": "vision_json", "channels": "channels_json",
+                 "families": "families_json"}
+_BOOL_COLUMNS = ("warmup", "success", "violation")
+_TIME_COLUMNS = ("started_at", "finished_at", "recorded_at")
+
+
+def episode_meta(spec: EpisodeSpec, outcome: EpisodeOutcome, policy: str) -> EpisodeMeta:
+    """Where the episode sits in the grid, as the metrics name it."""
+    category = outcome.instruction.metric_category if outcome.instruction else None
+    return EpisodeMeta(scenario=spec.scenario, suite=spec.suite,
+                       embodiment=outcome.embodiment or spec.embodiment, level=spec.level,
+                       language=spec.language, vision=spec.vision, seed=spec.seed,
+                       policy=policy, language_category=category)  # type: ignore[arg-type]
+
+
+def score(spec: EpisodeSpec, outcome: EpisodeOutcome, policy: str) -> EpisodeMetrics | None:
+    """The episode's metrics (see the module doc); None when no step can be scored."""
+    record = outcome.record
+    if record is None:
+        return None
+    channels = tuple(ChannelInfo.model_validate(c) for c in record["channels"])
+    margins = np.array(record["margins"], dtype=np.float64).reshape(-1, len(channels))
+    faulted = outcome.failure_reason is not None
+    if faulted:
+        finite = np.isfinite(margins).all(axis=1)
+        margins = margins[: int(np.argmin(finite)) if not finite.all() else len(finite)]
+        if len(margins) == 0:
+            return None
+    trace = EpisodeTrace(channels=channels, margins=margins,
+                         success=bool(record["success"]) and not faulted,
+                         meta=episode_meta(spec, outcome, policy))
+    return episode_metrics(trace)
+
+
+def build_row(spec: EpisodeSpec, outcome: EpisodeOutcome, *, policy: str, lam: float,
+              session_id: int, trace_path: str | None) -> EpisodeRow:
+    """The ``episodes`` row of a finished episode (raises ValueError on bad input)."""
+    _check_levels(spec, outcome)
+    metrics = score(spec, outcome, policy)
+    meta = episode_meta(spec, outcome, policy)
+    instruction = outcome.instruction
+    measured: dict[str, Any] = dict.fromkeys(
+        ("success", "violation", "quadrant", "horizon", "cc", "cc_normalised", "ret",
+         "ret_fraction", "sasr", "channels", "families"))
+    if metrics is not None:
+        measured.update(success=metrics.success, violation=metrics.violation,
+                        quadrant=metrics.quadrant, horizon=metrics.horizon, cc=metrics.cc,
+                        cc_normalised=metrics.cc_normalised, ret=metrics.ret,
+                        ret_fraction=metrics.ret_fraction, sasr=metrics.sasr(lam),
+                        channels=metrics.channels, families=metrics.families)
+    return EpisodeRow(
+        episode_id=spec.episode_id, session_id=session_id, policy=policy,
+        scenario=spec.scenario, scenario_ref=spec.scenario_ref,
+        scenario_digest=spec.scenario_digest, suite=spec.suite, embodiment=meta.embodiment,
+        level=spec.level, language=spec.language, vision=spec.vision, seed=spec.seed,
+        episode_index=spec.episode_index, language_seed=spec.language_seed,
+        vision_seed=spec.vision_seed, policy_seed=spec.policy_seed, warmup=spec.warmup,
+        instruction=instruction.text if instruction else None,
+        instruction_origin=instruction.origin if instruction else None,
+        instruction_category=instruction.category if instruction else None,
+        language_category=meta.language_category, vision_category=meta.vision_category,
+        perturbation=outcome.perturbation, layout_digest=outcome.layout_digest,
+        status=outcome.status, failure_reason=outcome.failure_reason,
+        failure_detail=outcome.failure_detail,
+        steps=len(outcome.record["margins"]) if outcome.record is not None else 0,
+        sasr_lambda=lam, wall_time_s=outcome.wall_time_s, started_at=outcome.started_at,
+        finished_at=outcome.finished_at, recorded_at=datetime.now(timezone.utc),
+        trace_path=trace_path, **measured)
+
+
+def _check_levels(spec: EpisodeSpec, outcome: EpisodeOutcome) -> None:
+    given = {"instruction": (outcome.instruction, spec.language),
+             "perturbation": (outcome.perturbation, spec.vision)}
+    for name, (value, level) in given.items():
+        if value is not None and value.level != level:
+            raise ValueError(f"episode {spec.episode_id} is at {level} but its {name} is at "
+                             f"{value.level}")
+
+
+def row_metrics(row: EpisodeRow) -> EpisodeMetrics | None:
+    """The :class:`EpisodeMetrics` stored in ``row``; None for a row without metrics."""
+    if row.horizon is None:
+        return None
+    meta = EpisodeMeta(scenario=row.scenario, suite=row.suite, embodiment=row.embodiment,
+                       level=row.level, language=row.language, vision=row.vision,
+                       seed=row.seed, policy=row.policy, language_category=row.language_category,
+                       vision_category=row.vision_category)
+    return EpisodeMetrics(meta=meta, success=row.success, violation=row.violation,
+                          quadrant=row.quadrant, horizon=row.horizon, cc=row.cc,
+                          cc_normalised=row.cc_normalised, ret=row.ret,
+                          ret_fraction=row.ret_fraction, channels=row.channels or (),
+                          families=row.families or ())
+
+
+def unscored_failure(row: EpisodeRow) -> EpisodeMetrics:
+    """A row without metrics counted as the paper counts it: a failure without exposure
+    (safe_failure, T = 1, CC = RET = 0, no channels)."""
+    meta = EpisodeMeta(scenario=row.scenario, suite=row.suite, embodiment=row.embodiment,
+                       level=row.level, language=row.language, vision=row.vision,
+                       seed=row.seed, policy=row.policy, language_category=row.language_category,
+                       vision_category=row.vision_category)
+    return EpisodeMetrics(meta=meta, success=False, violation=False, quadrant="safe_failure",
+                          horizon=1, cc=0.0, cc_normalised=0.0, ret=0, ret_fraction=0.0,
+                          channels=(), families=())
+
+
+def row_to_sql(row: EpisodeRow) -> dict[str, Any]:
+    """The row as SQLite parameters: JSON text for nested values, 0/1 for flags."""
+    data = row.model_dump(mode="json")
+    for field, column in _JSON_COLUMNS.items():
+        value = data.pop(field)
+        data[column] = None if value is None else json.dumps(value, allow_nan=False)
+    for field in _BOOL_COLUMNS:
+        data[field] = None if data[field] is None else int(data[field])
+    for field in ("cc", "cc_normalised", "ret_fraction", "sasr", "sasr_lambda", "wall_time_s"):
+        data[field] = getattr(row, field)  # the float itself, not its JSON rendering
+    return data
+
+
+def row_from_sql(values: sqlite3.Row) -> EpisodeRow:
+    """Inverse of :func:`row_to_sql`."""
+    data = dict(values)
+    for field, column in _JSON_COLUMNS.items():
+        text = data.pop(column)
+        data[field] = None if text is None else json.loads(text)
+    for field in _BOOL_COLUMNS:
+        data[field] = None if data[field] is None else bool(data[field])
+    return EpisodeRow.model_validate(data)
+
+
+__all__ = ["build_row", "episode_meta", "row_from_sql", "row_metrics", "row_to_sql", "score",
+           "unscored_failure"]

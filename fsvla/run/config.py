@@ -1,0 +1,89 @@
+"""The configuration of one ``fsvla run``: what is evaluated, on which grid, how.
+
+A :class:`RunConfig` is stored in the run folder; running again on the folder resumes it
+only when the configuration is the same (:func:`config_differences` says what differs).
+``--extend`` may grow the grid (:data:`GRID_FIELDS`) but never change how episodes are
+run (policy, modes, embodiment, λ, timeouts), which would mix incomparable episodes.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+from fsvla.metrics.trace import Language, Level, Vision
+
+CONFIG_FORMAT_VERSION = 1
+LEVELS: tuple[Level, ...] = ("L0", "L1", "L2")
+LANGUAGES: tuple[Language, ...] = ("W0", "W1", "W2", "W3", "W4")
+VISIONS: tuple[Vision, ...] = ("V0", "V1", "V2", "V3", "V4")
+#: Fields ``--extend`` may change: they add episodes, they do not alter finished ones.
+GRID_FIELDS: frozenset[str] = frozenset(
+    {"scenarios", "levels", "languages", "visions", "episodes", "seeds", "warmup"})
+
+
+class RunConfig(BaseModel):
+    """What ``fsvla run`` evaluates: one policy over scenarios × L × W × V × episodes."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    format_version: Literal[1] = CONFIG_FORMAT_VERSION
+    policy: str = Field(min_length=1)  # a --policy spec (fsvla.policies.registry)
+    scenarios: tuple[str, ...] = Field(min_length=1)  # files, folders or built-in names
+    levels: tuple[Level, ...] = ("L0",)
+    languages: tuple[Language, ...] = ("W0",)
+    visions: tuple[Vision, ...] = ("V0",)
+    episodes: int = Field(default=1, ge=1)  # per cell (scenario × L × W × V), over the seeds
+    seeds: tuple[int, ...] = Field(default=(0,), min_length=1)  # layout seeds
+    warmup: int = Field(default=1, ge=0)  # unscored episodes per scenario at L0/W0/V0, first
+    control_mode: Literal["joint_pos", "ee_pose"] = "joint_pos"
+    obs_mode: Literal["state", "rgb"] = "state"
+    embodiment: str | None = None  # None: each scenario's own
+    sasr_lambda: float = Field(default=1.0, ge=0, allow_inf_nan=False)  # λ of SASR
+    terminate_on_violation: bool = False
+    policy_timeout_s: float | None = Field(default=None, gt=0, allow_inf_nan=False)  # per act()
+
+    @field_validator("levels", "languages", "visions")
+    @classmethod
+    def _sorted_unique(cls, value: tuple[str, ...]) -> tuple[str, ...]:
+        if not value:
+            raise ValueError("name at least one level")
+        return tuple(sorted(set(value)))
+
+    @field_validator("seeds")
+    @classmethod
+    def _seeds_unique(cls, value: tuple[int, ...]) -> tuple[int, ...]:
+        negative = [s for s in value if s < 0]
+        if negative:
+            raise ValueError(f"seeds must be >= 0, got {negative[0]}")
+        if len(set(value)) != len(value):
+            raise ValueError(f"seeds must not repeat, got {list(value)}")
+        return value
+
+
+class ConfigDifference(BaseModel):
+    """One field whose stored and given values differ."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    field: str
+    stored: Any
+    given: Any
+    extendable: bool  # in GRID_FIELDS: --extend accepts the change
+
+    def describe(self) -> str:
+        return f"{self.field}: {self.stored!r} in the run folder, {self.given!r} now"
+
+
+def config_differences(stored: RunConfig, given: RunConfig) -> tuple[ConfigDifference, ...]:
+    """The fields that differ between two configurations, in field order."""
+    old, new = stored.model_dump(mode="json"), given.model_dump(mode="json")
+    return tuple(
+        ConfigDifference(field=name, stored=old[name], given=new[name],
+                         extendable=name in GRID_FIELDS)
+        for name in RunConfig.model_fields if old[name] != new[name])
+
+
+__all__ = ["CONFIG_FORMAT_VERSION", "GRID_FIELDS", "LANGUAGES", "LEVELS", "VISIONS",
+           "ConfigDifference", "RunConfig", "config_differences"]
