@@ -14,13 +14,12 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import ast
+from . import ast, lalr
 from .build import build_ast
 from .check import ScenarioChecker
 from .diagnostics import Diagnostic, DiagnosticSink, Severity
 from .merge import merge
 from .models import Scenario
-from .parser import parse_tree
 from .spans import Span
 
 MAX_FILE_BYTES = 1_000_000
@@ -119,6 +118,14 @@ class ScenarioLoader:
 
     @staticmethod
     def _parse_text(text: str, name: str) -> tuple[ast.ScenarioDecl | None, list[Diagnostic]]:
+        """The AST, or None and the syntax errors: in one pass when the text has none (the
+        usual case); else lark parses it again, recovering to report every error."""
+        try:
+            return lalr.parse(text if text.endswith("\n") else text + "\n", name), []
+        except lalr.Unparsed:
+            pass
+        from .parser import parse_tree  # imports lark: only files with errors need it
+
         tree, diagnostics = parse_tree(text, name)
         if tree is None:
             return None, diagnostics
