@@ -1,0 +1,112 @@
+"""The report's header: the protocol each run followed, read from its run folder.
+
+Scenarios, L/W/V levels, seeds, episodes per cell, warm-up, λ, how faults count, the CC
+normalisation and the software versions (every writer session's, so a run resumed after
+an upgrade says so). Fields that differ between the runs compared are listed, since
+their numbers are then not directly comparable.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from pydantic import BaseModel, ConfigDict
+
+from fsvla.report.data import RunData
+from fsvla.report.tables import Settings
+
+FAULT_POLICY = ("Faulted episodes count as task failures, scored on the steps that ran "
+                "(with none, as a safe failure without exposure); warm-up episodes are "
+                "excluded from every number.")
+#: Protocol fields compared across runs (their values should agree for a fair comparison).
+COMPARED = ("scenario_names", "levels", "languages", "visions", "episodes_per_cell", "seeds",
+            "warmup", "sasr_lambda", "control_mode", "obs_mode", "terminate_on_violation")
+
+
+class RunProtocol(BaseModel):
+    """One run's protocol."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    label: str
+    run_dir: str
+    policy: str
+    scenarios: tuple[str, ...]  # as given to fsvla run (files, folders, names)
+    scenario_names: tuple[str, ...]  # the scenarios its scored episodes come from
+    suites: tuple[str, ...]
+    embodiments: tuple[str, ...]
+    levels: tuple[str, ...]
+    languages: tuple[str, ...]
+    visions: tuple[str, ...]
+    episodes_per_cell: int
+    seeds: tuple[int, ...]
+    warmup: int  # warm-up episodes per scenario (configured)
+    warmups_recorded: int  # excluded from every number
+    episodes_scored: int
+    faults: dict[str, int]
+    sasr_lambda: float
+    control_mode: str
+    obs_mode: str
+    terminate_on_violation: bool
+    created_at: str
+    updated_at: str
+    versions: dict[str, str]  # package -> version(s), "a → b" when sessions differ
+    cc_normalisation: str
+
+
+class Protocol(BaseModel):
+    """The header of a report."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    runs: tuple[RunProtocol, ...]
+    differences: tuple[str, ...]  # COMPARED fields whose values differ between runs
+    cc_normalisation: str
+    fault_policy: str = FAULT_POLICY
+    confidence: float
+    n_resamples: int
+    bootstrap_seed: int
+
+
+def _versions(run: RunData) -> dict[str, str]:
+    seen: dict[str, list[str]] = {}
+    history = [s.get("versions") or {} for s in run.sessions] or [run.info.versions]
+    for versions in (run.info.versions, *history):
+        for name, version in versions.items():
+            values = seen.setdefault(name, [])
+            if version not in values:
+                values.append(str(version))
+    return {name: " → ".join(values) for name, values in seen.items()}
+
+
+def run_protocol(run: RunData) -> RunProtocol:
+    config = run.info.config
+    metas = [e.metrics.meta for e in run.episodes]
+    return RunProtocol(
+        label=run.label, run_dir=str(run.run_dir), policy=config.policy,
+        scenarios=config.scenarios,
+        scenario_names=tuple(sorted({m.scenario for m in metas})),
+        suites=tuple(sorted({m.suite for m in metas})),
+        embodiments=tuple(sorted({m.embodiment for m in metas})),
+        levels=config.levels, languages=config.languages, visions=config.visions,
+        episodes_per_cell=config.episodes, seeds=config.seeds, warmup=config.warmup,
+        warmups_recorded=run.warmups, episodes_scored=len(run.episodes),
+        faults=run.fault_counts(), sasr_lambda=config.sasr_lambda,
+        control_mode=config.control_mode, obs_mode=config.obs_mode,
+        terminate_on_violation=config.terminate_on_violation,
+        created_at=run.info.created_at.isoformat(timespec="seconds"),
+        updated_at=run.info.updated_at.isoformat(timespec="seconds"),
+        versions=_versions(run), cc_normalisation=run.info.cc_normalisation)
+
+
+def protocol(runs: Sequence[RunData], settings: Settings) -> Protocol:
+    protocols = tuple(run_protocol(r) for r in runs)
+    differences = tuple(f for f in COMPARED
+                        if len({repr(getattr(p, f)) for p in protocols}) > 1)
+    statements = list(dict.fromkeys(p.cc_normalisation for p in protocols))
+    return Protocol(runs=protocols, differences=differences,
+                    cc_normalisation="\n".join(statements), confidence=settings.confidence,
+                    n_resamples=settings.n_resamples, bootstrap_seed=settings.seed)
+
+
+__all__ = ["COMPARED", "FAULT_POLICY", "Protocol", "RunProtocol", "protocol", "run_protocol"]
