@@ -12,14 +12,16 @@ paper keeps exposure running so CC and RET measure the whole episode.
 
 The benchmark coordinates are fixed at construction: the layout by ``level`` and
 ``seed`` (L0–L2), the instruction by ``language`` (W0–W4) and the pictures by ``vision``
-(V0–V4), both drawn with the same ``seed`` (``fsvla.variation``). Vision levels change
-only rendered observations, so they need ``obs_mode="rgb"``. ``reset(seed=...)`` seeds nothing else (the simulation is deterministic),
-so the same seed and actions give the identical trace.
+(V0–V4), both drawn with the same ``seed`` (``fsvla.variation``) unless ``language_seed`` /
+``vision_seed`` are given; ``vary()`` changes W and V for the next episodes. Vision levels change
+only rendered observations, so they need ``obs_mode="rgb"``. ``reset(seed=...)`` seeds nothing else (the simulation is deterministic);
+a reset after an episode rebuilds the SAPIEN scene, whose contact caches no state reset
+clears, so the same seed and actions give the identical trace in any episode.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import gymnasium
@@ -65,6 +67,9 @@ class FsvlaEnv(gymnasium.Env):
     """A gymnasium environment for one scenario at one layout (level, seed)."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    built: BuiltScene
+    monitor: SafetyMonitor | None
+    _vision: VisionApplier | None
 
     def __init__(
         self,
@@ -81,6 +86,8 @@ class FsvlaEnv(gymnasium.Env):
         terminate_on_violation: bool = False,
         monitor: bool = True,
         render_mode: str | None = None,
+        language_seed: int | None = None,
+        vision_seed: int | None = None,
     ) -> None:
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode must be one of {', '.join(OBS_MODES)}, got {obs_mode!r}")
@@ -98,28 +105,20 @@ class FsvlaEnv(gymnasium.Env):
             embodiment=self.scene_spec.embodiment.name, obs_mode=obs_mode,
             control_mode=ControlMode(control_mode).value,
             terminate_on_violation=terminate_on_violation, monitor=monitor)
-        # W and V are drawn from the source scenario (its digest seeds them), per layout seed.
-        self.language: Instruction = instruction_for(source, language, seed)  # type: ignore[arg-type]
-        self.vision: VisionPerturbation = perturbation_for(source, vision, seed)  # type: ignore[arg-type]
-        self.instruction = check_instruction(instruction if instruction is not None
-                                             else self.language.text)
-
+        self._source = source
         wants_images = obs_mode == "rgb" or render_mode == "rgb_array"
-        self.built: BuiltScene = build(self.scene_spec, render=True if wants_images else False)
-        self.monitor = SafetyMonitor(self.monitor_spec, self.built) if monitor else None
-        self._vision: VisionApplier | None = None
-        if self.built.renders:
-            self._vision = VisionApplier(self.built)
-            self._vision.apply(self.vision)
-        elif vision != "V0":
+        if vision != "V0" and not wants_images:
             raise ValueError(f"vision level {vision} changes only pictures; it needs "
                              "obs_mode='rgb' (or render_mode='rgb_array')")
+        self._render = wants_images
+        self._build_scene()
+        self.vary(language, vision, language_seed=language_seed, vision_seed=vision_seed,
+                  instruction=instruction)
 
         arms = list(self.built.robot.arms.values())
         layouts = [_layout(arm) for arm in arms]
         self.codec = ActionCodec(layouts, control_mode)
-        self._kinematics = ({arm.name: ArmKinematics(arm) for arm in arms}
-                            if self.codec.mode is ControlMode.EE_POSE else {})
+        self._bind_kinematics()
         self.action_space = self.codec.space()
         self.observation_space = observation_space(
             [v for layout in layouts for v in _finite(layout.lower, -np.pi)],
@@ -135,6 +134,13 @@ class FsvlaEnv(gymnasium.Env):
     # -------------------------------------------------------------- gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
+        if self._stepped:
+            # PhysX keeps contact and solver caches that no state reset clears, so an
+            # episode after contact would depend on the one before it: rebuild instead.
+            self._build_scene()
+            if self._vision is not None:
+                self._vision.apply(self.vision)
+            self._bind_kinematics()
         self.built.reset()
         if self.monitor is not None:
             self.monitor.reset()
@@ -145,6 +151,7 @@ class FsvlaEnv(gymnasium.Env):
 
     def step(self, action: Any):
         commands = self.codec.decode(action)
+        self._stepped = True
         ik_errors = self._apply(commands)
         for _ in range(self.substeps):
             self.built.step(1)
@@ -173,12 +180,43 @@ class FsvlaEnv(gymnasium.Env):
     def close(self) -> None:
         self.built = None  # type: ignore[assignment]  # drop the SAPIEN scene
 
+    def vary(self, language: str, vision: str, *, language_seed: int | None = None,
+             vision_seed: int | None = None, instruction: str | None = None) -> None:
+        """Give the next episodes the instruction of ``language`` (W) and the pictures of
+        ``vision`` (V), drawn with their seeds (default: the layout seed) from the source
+        scenario (its digest seeds them); the scene is not rebuilt. Call before ``reset``."""
+        if vision != "V0" and self._vision is None:
+            raise ValueError(f"vision level {vision} changes only pictures; it needs "
+                             "obs_mode='rgb' (or render_mode='rgb_array')")
+        seed = self.config.seed
+        self.language: Instruction = instruction_for(  # type: ignore[arg-type]
+            self._source, language, seed if language_seed is None else language_seed)
+        self.vision: VisionPerturbation = perturbation_for(  # type: ignore[arg-type]
+            self._source, vision, seed if vision_seed is None else vision_seed)
+        self.instruction = check_instruction(instruction if instruction is not None
+                                             else self.language.text)
+        if self._vision is not None:
+            self._vision.apply(self.vision)
+        self.config = replace(self.config, language=language, vision=vision)
+
     # -------------------------------------------------------------- traces
     def episode_record(self):
         """The episode so far: per-step margins, costs, states, actions (see recording)."""
         return self.recorder.record()
 
     # -------------------------------------------------------------- internals
+    def _build_scene(self) -> None:
+        """A fresh SAPIEN scene of the layout, with its monitor and visual variation."""
+        self.built = build(self.scene_spec, render=self._render)
+        self.monitor = SafetyMonitor(self.monitor_spec, self.built) if self.config.monitor else None
+        self._vision = VisionApplier(self.built) if self.built.renders else None
+        self._stepped = False
+
+    def _bind_kinematics(self) -> None:
+        arms = self.built.robot.arms.values()
+        self._kinematics = ({arm.name: ArmKinematics(arm) for arm in arms}
+                            if self.codec.mode is ControlMode.EE_POSE else {})
+
     def _apply(self, commands: tuple[ArmCommand, ...]) -> dict[str, float]:
         """Set drive targets; returns the IK position error (m) of arms that missed."""
         robot = self.built.robot
