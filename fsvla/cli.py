@@ -288,6 +288,69 @@ def preview(path: Path, roots: tuple[Path, ...], level: str, seed: int, out_path
                      f"{scene.scenario} {level} seed {seed})")
 
 
+@main.command(name="report")
+@click.argument("run_dirs", nargs=-1, required=True,
+                type=click.Path(exists=True, file_okay=False, path_type=Path))
+@click.option("-o", "--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
+              help="Folder to write the report into (created if missing).")
+@click.option("--episode", default=None, metavar="ID",
+              help="Episode to dissect (LABEL:ID when several runs hold ID). Default: the unsafe "
+                   "success with the largest RET.")
+@click.option("--label", "labels", multiple=True, metavar="NAME",
+              help="Name of each run's policy in tables and figures, one per run folder in order. "
+                   "Default: the --policy each run was made with.")
+@click.option("--formats", default="html,md,json,tex,png,pdf,csv", show_default=True,
+              help="Comma-separated, among html, md, json, tex, png, pdf, svg, csv, parquet.")
+@click.option("--no-figures", is_flag=True, help="Write tables only (no matplotlib needed).")
+@click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
+              show_default=True, help="Confidence level of every interval.")
+@click.option("--resamples", type=click.IntRange(min=1), default=2000, show_default=True,
+              help="Bootstrap resamples for the intervals of means.")
+def report_command(run_dirs: tuple[Path, ...], out_dir: Path, episode: str | None,
+                   labels: tuple[str, ...], formats: str, no_figures: bool, confidence: float,
+                   resamples: int) -> None:
+    """Report one or many runs (one policy each) from their run folders: aggregate and
+    per-suite/category/embodiment tables, the safety-success landscape, diagnosis under L/W/V
+    variation, and the process-level dissection of one episode, as HTML, Markdown, LaTeX,
+    figures and CSV."""
+    import sqlite3
+
+    from rich.markup import escape
+
+    from .report import ReportInputError, Settings, build_report, load_runs, write_report
+    from .report.figures import FiguresUnavailable
+    from .report.write import check_formats
+
+    err = _console(stderr=True)
+    try:
+        chosen = check_formats(formats.split(","))
+    except ValueError as problem:
+        raise click.BadParameter(str(problem), param_hint="--formats") from None
+    try:
+        runs = load_runs(list(run_dirs), list(labels) or None)
+        settings = Settings(confidence=confidence, n_resamples=resamples)
+        built = build_report(runs, episode=episode, settings=settings)
+        written = write_report(built, runs, out_dir, chosen, figures=not no_figures)
+    except ReportInputError as problem:
+        err.print(f"[bold red]error:[/bold red] {escape(str(problem))}")
+        sys.exit(problem.exit_code)
+    except (FiguresUnavailable, ImportError, ValueError, OSError, sqlite3.Error) as problem:
+        err.print(f"[bold red]error:[/bold red] {escape(str(problem))}")
+        sys.exit(1)
+    out = _console()
+    for path in (p for p in written if p.parent == out_dir):
+        out.print(f"[green]wrote[/green] {escape(str(path))}")
+    out.print(f"{len(written)} file(s) in {escape(str(out_dir))}{os.sep} for {len(runs)} run(s), "
+              f"{sum(len(r.episodes) for r in runs)} scored episode(s)", style="bold green")
+
+
+# `fsvla run` and `fsvla replay` live with the runner; importing them loads no simulator.
+from .runner.commands import replay_command, run_command
+
+main.add_command(run_command)
+main.add_command(replay_command)
+
+
 def run(argv: Iterable[str] | None = None) -> int:
     """Run the CLI and return its exit code instead of exiting (for tests and embedding)."""
     try:

@@ -1,0 +1,137 @@
+"""From ``fsvla run`` options to a checked run: scenarios loaded, configuration, plan.
+
+Everything here happens before anything is written: a bad option value raises
+:class:`RunInputError`, whose ``option`` names the option and whose message says what is
+wrong with it (the CLI prints it and exits 2).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from fsvla.run.config import RunConfig, config_differences
+from fsvla.run.plan import EpisodeSpec, PlannedScenario, plan_episodes
+
+#: Which option sets each RunConfig field (for error messages).
+OPTIONS: dict[str, str] = {
+    "policy": "--policy", "scenarios": "--scenarios", "levels": "--levels",
+    "languages": "--language", "visions": "--vision", "episodes": "--episodes",
+    "seeds": "--seeds", "warmup": "--warmup", "control_mode": "--control-mode",
+    "obs_mode": "--obs-mode", "embodiment": "--embodiment", "sasr_lambda": "--sasr-lambda",
+    "terminate_on_violation": "--terminate-on-violation", "policy_timeout_s": "--policy-timeout",
+}
+
+
+class RunInputError(ValueError):
+    """A ``fsvla run`` input that cannot be used; ``option`` names the option."""
+
+    def __init__(self, option: str, message: str) -> None:
+        self.option = option
+        super().__init__(message if message.startswith(option) else f"{option}: {message}")
+
+
+@dataclass(frozen=True)
+class PreparedRun:
+    """A run ready to execute: its configuration, scenarios and every planned episode."""
+
+    config: RunConfig
+    scenarios: tuple[PlannedScenario, ...]
+    plan: tuple[EpisodeSpec, ...]
+
+
+def scenario_refs(items: Sequence[str]) -> list[str]:
+    """The scenarios ``--scenarios`` names: each item (comma-separated, repeatable) is a
+    ``.fsv`` file, a folder searched recursively (``_base/`` folders, which hold abstract
+    bases, skipped), or a built-in scenario name."""
+    refs: list[str] = []
+    for item in (part.strip() for value in items for part in value.split(",")):
+        if not item:
+            continue
+        path = Path(item)
+        if path.is_dir():
+            found = [str(p) for p in sorted(path.rglob("*.fsv"))
+                     if p.is_file() and "_base" not in p.relative_to(path).parts]
+            if not found:
+                raise RunInputError("--scenarios", f"no .fsv files under {item}")
+            refs.extend(found)
+        else:
+            refs.append(item)
+    if not refs:
+        raise RunInputError("--scenarios", "name at least one scenario file, folder or "
+                            "built-in scenario")
+    return list(dict.fromkeys(refs))
+
+
+def plan_scenarios(items: Sequence[str]) -> list[PlannedScenario]:
+    """Load and check every scenario ``--scenarios`` names."""
+    from fsvla.library import ScenarioLoadError, load_scenario
+
+    planned = []
+    for ref in scenario_refs(items):
+        try:
+            planned.append(PlannedScenario.of(load_scenario(ref), ref=ref))
+        except ScenarioLoadError as err:
+            raise RunInputError("--scenarios", str(err)) from None
+    return planned
+
+
+def make_config(**fields: Any) -> RunConfig:
+    """A :class:`RunConfig`, with a validation error reported against its option."""
+    try:
+        config = RunConfig(**fields)
+    except ValidationError as err:
+        first = err.errors()[0]
+        field = str(first["loc"][0]) if first["loc"] else ""
+        raise RunInputError(OPTIONS.get(field, field or "options"), first["msg"]) from None
+    if config.obs_mode == "state" and config.visions != ("V0",):
+        raise RunInputError("--vision", f"{', '.join(v for v in config.visions if v != 'V0')} "
+                            "change only the pictures a policy sees; they need --obs-mode rgb")
+    if config.embodiment is not None:
+        from fsvla.embodiments import load_embodiment
+
+        try:
+            load_embodiment(config.embodiment)
+        except (KeyError, ValueError, OSError) as err:
+            raise RunInputError("--embodiment", str(err.args[0] if err.args else err)) from None
+    return config
+
+
+def prepare_run(config: RunConfig) -> PreparedRun:
+    """Load the configuration's scenarios and plan its episodes."""
+    scenarios = plan_scenarios(config.scenarios)
+    try:
+        plan = plan_episodes(config, scenarios)
+    except ValueError as err:
+        raise RunInputError("--scenarios", str(err)) from None
+    return PreparedRun(config=config, scenarios=tuple(scenarios), plan=tuple(plan))
+
+
+def check_run_folder(out: Path, config: RunConfig, *, extend: bool = False) -> bool:
+    """Whether ``out`` holds a run to resume; raises :class:`RunInputError` when it holds
+    one this configuration cannot resume (or extend), or something else altogether."""
+    from fsvla.results import ResultStore, RunConfigMismatch
+
+    if out.exists() and not out.is_dir():
+        raise RunInputError("--out", f"{out} is a file, not a run folder")
+    try:
+        if not ResultStore.exists(out):
+            return False
+        with ResultStore.open(out, readonly=True) as store:
+            stored = store.config
+    except ValueError as err:
+        raise RunInputError("--out", str(err)) from None
+    differences = config_differences(stored, config)
+    fixed = [d for d in differences if not d.extendable]
+    if fixed or (differences and not extend):
+        mismatch = RunConfigMismatch(out, fixed if extend else differences, extend)
+        raise RunInputError("--out", str(mismatch))
+    return True
+
+
+__all__ = ["OPTIONS", "PreparedRun", "RunInputError", "check_run_folder", "make_config",
+           "plan_scenarios", "prepare_run", "scenario_refs"]
