@@ -22,9 +22,25 @@ from fsvla.dsl.diagnostics import did_you_mean
 from .base import Policy
 from .simple import HoldStillPolicy, RandomPolicy
 
+
+def _careful_expert() -> Any:
+    from fsvla.experts import CarefulExpert
+
+    return CarefulExpert()
+
+
+def _careless_expert() -> Any:
+    from fsvla.experts import CarelessExpert
+
+    return CarelessExpert()
+
+
 BUILTIN: dict[str, Callable[[], Any]] = {
     "random": RandomPolicy,
     "hold-still": HoldStillPolicy,
+    # scripted experts: they need bind_env(env) before reset (see fsvla.experts)
+    "careful-expert": _careful_expert,
+    "careless-expert": _careless_expert,
 }
 
 

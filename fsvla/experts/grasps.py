@@ -1,0 +1,183 @@
+"""Grasps per asset kind, from the asset's collision geometry at the object's current pose.
+
+Each function returns candidate grasps; the careful expert takes the one farthest from
+the hazards, the careless one the first (the most direct for the arm).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .motion import Pose
+from .skills import Grasp, horizontal, top_down_grasp
+from .style import Style
+from .world import World
+
+
+def grasps(world: World, arm: str, obj: str) -> list[Grasp]:
+    kind = world.kind(obj)
+    maker = _MAKERS.get(kind, _generic)
+    return maker(world, arm, obj)
+
+
+def reachable(world: World, arm: str, grasp: Grasp) -> bool:
+    """Whether the arm reaches the grasp, and 5 cm back along its approach, comfortably
+    inside its joint limits."""
+    from .motion import ArmDriver
+
+    loaded = world.robot.arm(arm)
+    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm), loaded.qpos(), 1.0)
+    for pose in (grasp.pose, grasp.pose.moved(-0.05 * grasp.approach)):
+        driver.solve_anywhere(pose)
+        if driver.ik_misses:
+            return False
+    return True
+
+
+def tilted(world: World, arm: str, grasp: Grasp, angle: float) -> Grasp:
+    """The grasp with its approach tilted by ``angle`` toward the arm's base, the wrist
+    leaning out (a top-down grasp close to the base folds the elbow onto its limit)."""
+    toward = horizontal(world.base_position(arm) - grasp.pose.p)
+    approach = np.cos(angle) * grasp.approach + np.sin(angle) * toward
+    closing = grasp.pose.R @ world.finger_axis(arm)
+    R = world.grasp_frame(arm, approach, closing, near=grasp.pose.R)
+    return Grasp(Pose(grasp.pose.p, R), grasp.width, approach / np.linalg.norm(approach))
+
+
+def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
+    """The grasp the style takes among :func:`grasps` the arm can reach (tilted away
+    from the base when it must be)."""
+    found = grasps(world, arm, obj)
+    ok = [g for g in found if reachable(world, arm, g)]
+    for angle in np.deg2rad([20.0, 35.0, 50.0]):
+        if ok:
+            break
+        ok = [t for t in (tilted(world, arm, g, angle) for g in found) if reachable(world, arm, t)]
+    found = ok or found
+    if not style.avoid_hazards or len(found) == 1:
+        return found[0]
+    obstacles = world.obstacles(exclude=(obj,))
+    if not obstacles:
+        return found[0]
+
+    def clearance(g: Grasp) -> float:
+        p = g.pose.p
+        return min(float(np.linalg.norm(np.maximum(0, np.maximum(o.lo - p, p - o.hi))))
+                   for o in obstacles)
+
+    return max(found, key=clearance)
+
+
+def _side_to_arm(world: World, arm: str, point: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Unit horizontal direction from ``point`` toward the arm's base."""
+    return horizontal(world.base_position(arm) - point)
+
+
+def _cylinder(world: World, arm: str, obj: str) -> list[Grasp]:
+    """An upright cylinder narrower than the gripper: fingers around it, from above, at
+    two thirds of its height; else on its rim (one finger inside, one outside)."""
+    pose = world.body_pose(obj)
+    r, h = world.param(obj, "radius"), world.param(obj, "height")
+    towards = _side_to_arm(world, arm, pose.p)
+    across = np.cross(UPV, towards)
+    if 2 * r < 0.92 * world.max_width(arm):
+        centre = pose.p + np.array([0.0, 0.0, max(0.3 * h, h - HAND_DEPTH)])
+        return [top_down_grasp(world, arm, centre, across, 2 * r),
+                top_down_grasp(world, arm, centre, towards, 2 * r)]
+    return _rim(world, arm, obj, r, h, towards)
+
+
+UPV = np.array([0.0, 0.0, 1.0])
+#: The hand's body reaches down to 37 mm above the TCP: a top-down TCP stays this far
+#: (m) below an object's top, so that the palm clears it by 9 mm.
+HAND_DEPTH = 0.028
+
+
+def _mug(world: World, arm: str, obj: str) -> list[Grasp]:
+    """A mug is as wide as the gripper opens: clamp its handle radially, one finger inside
+    the cup against the handle's upper arm, the other outside the grip bar."""
+    try:
+        high, grip = world.shape(obj, "handle_high"), world.shape(obj, "handle_grip")
+    except StopIteration:
+        return _cylinder(world, arm, obj)
+    pose = world.body_pose(obj)
+    inner = float(high.pose.position[0] - high.half_size[0])
+    outer = float(grip.pose.position[0] + grip.half_size[0])
+    z = float(high.pose.position[2])
+    centre = world.to_world(obj, (0.5 * (inner + outer), 0.0, z))
+    return [top_down_grasp(world, arm, centre, pose.R[:, 0], outer - inner)]
+
+
+def _rim(world: World, arm: str, obj: str, r: float, h: float,
+         towards: NDArray[np.float64]) -> list[Grasp]:
+    pose = world.body_pose(obj)
+    wall = 0.005
+    handle = pose.R[:, 0]  # mugs and kettles have their handle on local +x
+    out: list[tuple[float, Grasp]] = []
+    for angle in np.linspace(0.0, 2 * np.pi, 12, endpoint=False):
+        radial = np.array([np.cos(angle), np.sin(angle), 0.0])
+        if world.kind(obj) in ("mug", "kettle") and radial @ horizontal(handle) > 0.5:
+            continue
+        centre = pose.p + radial * (r - wall / 2) + np.array([0.0, 0.0, h - HAND_DEPTH])
+        grasp = top_down_grasp(world, arm, centre, radial, wall)
+        out.append((-float(radial @ towards), grasp))
+    return [g for _, g in sorted(out, key=lambda item: item[0])]
+
+
+def _block(world: World, arm: str, obj: str) -> list[Grasp]:
+    pose = world.body_pose(obj)
+    shape = world.asset(obj).collision[0]
+    half = np.asarray(shape.half_size)
+    centre = world.to_world(obj, shape.pose.position)
+    towards = _side_to_arm(world, arm, pose.p)
+    out = []
+    for axis in (0, 1):
+        closing = pose.R[:, axis]
+        if 2 * half[axis] < 0.92 * world.max_width(arm):
+            g = top_down_grasp(world, arm, centre + np.array([0.0, 0.0, 0.3 * half[2]]), closing,
+                               2 * half[axis])
+            out.append((abs(float(closing @ towards)), g))
+    return [g for _, g in sorted(out, key=lambda item: item[0])]
+
+
+def _knife(world: World, arm: str, obj: str) -> list[Grasp]:
+    shape = world.shape(obj, "handle")
+    pose = world.body_pose(obj)
+    centre = world.to_world(obj, shape.pose.position)
+    centre[2] = pose.p[2] + 2 * shape.half_size[2] - 0.005
+    return [top_down_grasp(world, arm, centre, pose.R[:, 1], 2 * shape.half_size[1])]
+
+
+def _generic(world: World, arm: str, obj: str) -> list[Grasp]:
+    lo, hi = world.bounds(obj)
+    centre = (lo + hi) / 2
+    size = hi - lo
+    axis = 0 if size[0] <= size[1] else 1
+    closing = np.eye(3)[axis]
+    centre[2] = hi[2] - min(0.02, size[2] / 2)
+    return [top_down_grasp(world, arm, centre, closing, float(size[axis]))]
+
+
+def handle_grasp(world: World, arm: str, obj: str, handle: str) -> Grasp:
+    """A side grasp of a flat side handle (a pot's): the gripper comes horizontally from
+    outside and the fingers close across the handle's width, so that the hand lies flat
+    (a Panda hand turned with its fingers vertical would reach down into the table)."""
+    shape = world.shape(obj, handle)
+    pose = world.body_pose(obj)
+    centre = world.to_world(obj, shape.pose.position)
+    outward = horizontal(centre - pose.p)
+    approach = -outward
+    closing = np.cross(UPV, approach)
+    R = world.grasp_frame(arm, approach, closing)
+    tcp = centre + outward * 0.004
+    width = float(np.abs(pose.R.T @ closing) @ (2 * np.asarray(shape.half_size)))
+    return Grasp(Pose(tcp, R), width, approach)
+
+
+_MAKERS = {
+    "glass": _cylinder, "bottle": _cylinder, "mug": _mug, "vase": _cylinder,
+    "bowl": _cylinder, "kettle": _cylinder, "block": _block, "knife": _knife,
+}
+
+__all__ = ["choose", "grasps", "handle_grasp"]

@@ -1,0 +1,149 @@
+"""The scripted experts as policies: ``reset(EpisodeInfo)``, ``act(observation)`` → an
+action chunk, exactly like a learned policy, plus one hook for their privileged state.
+
+The hook: an expert must be bound to the environment it acts in before ``reset``::
+
+    expert = CarefulExpert()          # or load_policy("careful-expert")
+    expert.bind_env(env)              # env: the fsvla.env.FsvlaEnv of this episode
+    obs, info = env.reset()
+    expert.reset(episode_info)
+    chunk = expert.act(obs)           # (H, A) joint_pos or ee_pose actions
+
+A runner should call ``bind_env`` on every policy that has it (``needs_env = True``),
+once per episode, right after it builds the env; ``make_expert(env, "careful")`` does
+both steps for scripts. ``reset`` reads the scene's state, so it must come after
+``env.reset()``.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+
+from .motion import ArmDriver, Segment, Step, expand
+from .style import CAREFUL, CARELESS, STYLES, Style
+from .tasks import TASK_PLANS
+from .world import World
+
+#: Actions per chunk the experts return (the plan is re-read between segments anyway).
+CHUNK = 10
+
+
+class ExpertNotBound(RuntimeError):
+    """An expert was reset or asked to act without ``bind_env(env)``."""
+
+
+class ExpertPolicy:
+    """A scripted expert for the env it is bound to (see the module doc)."""
+
+    needs_env = True
+
+    def __init__(self, style: Style | str = CAREFUL, chunk: int = CHUNK) -> None:
+        self.style = STYLES[style] if isinstance(style, str) else style
+        self.name = f"{self.style.name}-expert"
+        self.chunk = chunk
+        self._env: Any = None
+        self._world: World | None = None
+        self._plan: Iterator[Segment] | None = None
+        self._queue: deque[Step] = deque()
+        self._drivers: dict[str, ArmDriver] = {}
+        self._last: Step | None = None
+        self.log: list[str] = []  # the segments executed, for tests and debugging
+        self.labels: list[str] = []  # the segment of every action returned
+
+    # ------------------------------------------------------------------ the hook
+    def bind_env(self, env: Any) -> None:
+        """Give the expert the environment whose privileged state it may read."""
+        self._env = env
+        self._world = World(env)
+
+    # ------------------------------------------------------------------ policy API
+    def reset(self, episode: Any = None) -> None:
+        if self._world is None:
+            raise ExpertNotBound(f"{self.name} needs the environment: call "
+                                 "bind_env(env) before reset (see fsvla.experts)")
+        world = self._world
+        task = world.scenario.task
+        if task.name not in TASK_PLANS:
+            raise ValueError(f"no expert plan for task {task.name!r}")
+        self._drivers = {}
+        for name in world.arm_names:
+            arm = world.robot.arm(name)
+            self._drivers[name] = ArmDriver(name, world.kinematics(name),
+                                            world.current_pose(name), arm.qpos(),
+                                            arm.gripper_opening())
+        self._plan = TASK_PLANS[task.name].plan(world, self.style, dict(task.roles))
+        self._queue.clear()
+        self._last = None
+        self.log = []
+        self.labels = []
+
+    def act(self, observation: dict[str, Any]) -> np.ndarray:
+        if not self._drivers:
+            raise ExpertNotBound(f"{self.name}: reset(episode) first")
+        while not self._queue and self._plan is not None:
+            segment = next(self._plan, None)
+            if segment is None:
+                self._plan = None
+                break
+            self.log.append(segment.label)
+            self._queue.extend(expand(segment, self._drivers, self._world.dt,
+                                      self.style.angular_speed))
+        steps = [self._queue.popleft() for _ in range(min(self.chunk, len(self._queue)))]
+        if not steps:  # the plan is done: hold the last command
+            steps = [self._last] if self._last is not None else [self._hold()]
+        self._last = steps[-1]
+        self.labels.extend(s.label for s in steps)
+        return np.stack([self._encode(s) for s in steps]).astype(np.float32)
+
+    @property
+    def ik_misses(self) -> int:
+        return sum(d.ik_misses for d in self._drivers.values())
+
+    # ------------------------------------------------------------------ encoding
+    def _hold(self) -> Step:
+        d = self._drivers
+        return Step({n: a.q.copy() for n, a in d.items()}, {n: a.pose for n, a in d.items()},
+                    {n: a.gripper for n, a in d.items()})
+
+    def _encode(self, step: Step) -> np.ndarray:
+        mode = self._env.codec.mode.value
+        parts: list[np.ndarray] = []
+        for name in self._world.arm_names:
+            g = float(np.clip(step.gripper[name], 0.0, 1.0))
+            if mode == "joint_pos":
+                parts.append(np.append(step.q[name], g))
+            else:
+                pose = step.pose[name]
+                parts.append(np.concatenate([pose.p, pose.quat, [g]]))
+        return np.concatenate(parts)
+
+
+class CarefulExpert(ExpertPolicy):
+    """Hazards and keep-out margins as obstacles, gentle speeds and grips, preconditions
+    in order."""
+
+    def __init__(self, chunk: int = CHUNK) -> None:
+        super().__init__(CAREFUL, chunk)
+
+
+class CarelessExpert(ExpertPolicy):
+    """The same task plans, hazard-blind: straight paths, full speed, full squeeze,
+    preconditions skipped where the task allows."""
+
+    def __init__(self, chunk: int = CHUNK) -> None:
+        super().__init__(CARELESS, chunk)
+
+
+def make_expert(env: Any, style: Style | str = "careful", chunk: int = CHUNK) -> ExpertPolicy:
+    """An expert bound to ``env`` (call ``reset`` after ``env.reset()``)."""
+    expert = ExpertPolicy(style, chunk)
+    expert.bind_env(env)
+    return expert
+
+
+__all__ = ["CHUNK", "CarefulExpert", "CarelessExpert", "ExpertNotBound", "ExpertPolicy",
+           "make_expert"]

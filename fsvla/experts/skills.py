@@ -1,0 +1,228 @@
+"""Skills the task plans are made of: grasp choice, transit, pick, place, pull a part,
+release. Each skill is a generator of :class:`~fsvla.experts.motion.Segment`; it reads the
+world when it is resumed, so a later skill sees where things ended up.
+
+Collision awareness lives in the waypoints: :func:`transit` raises the path to a height
+that clears every obstacle box under it (the task's objects always; the hazards and their
+keep-out distances only in the careful style) before it moves sideways.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .motion import Pose, Segment
+from .style import Style
+from .world import World
+
+DOWN = np.array([0.0, 0.0, -1.0])
+UP = np.array([0.0, 0.0, 1.0])
+#: Careful transit speed (m/s) while carrying an object heavier than LIGHT_LOAD (kg):
+#: faster moves shake it loose from the soft finger springs.
+CARRY_SPEED = 0.15
+LIGHT_LOAD = 0.1
+#: Height of the hand above its tool centre point (m), for clearing obstacles beneath it.
+HAND_RADIUS = 0.06
+
+Plan = Iterator[Segment]
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """Where to put the TCP to hold an object, the width to close on, and the direction
+    the gripper comes from (unit, pointing from the gripper toward the object)."""
+
+    pose: Pose
+    width: float
+    approach: NDArray[np.float64]
+
+
+def gentle(world: World, style: Style, obj: str) -> float:
+    """The speed of the last centimetres before touching ``obj``: the style's contact
+    speed where a force limit watches the object, else half its approach speed."""
+    return style.contact_speed if _force_watched(world, obj) else 0.5 * style.approach_speed
+
+
+def _force_watched(world: World, obj: str) -> bool:
+    """Whether a force or torque limit watches ``obj`` itself (a fragile object)."""
+    return any(c.metric in ("contact_force", "contact_torque") and obj in c.subjects
+               for c in world.monitor.channels)
+
+
+def free_speed(style: Style) -> float:
+    """Moving away from contact (lifting, backing off): half the transit speed."""
+    return max(style.approach_speed, 0.5 * style.transit_speed)
+
+
+def opening_for(world: World, arm: str, width: float, style: Style) -> float:
+    """Gripper opening that squeezes an object ``width`` wide with the style's force
+    (the finger drives are springs: force = stiffness × how far short of target)."""
+    if style.grip_force is None:
+        return 0.0
+    squeeze = 2.0 * style.grip_force / world.gripper_stiffness(arm)
+    return float(np.clip((width - squeeze) / world.max_width(arm), 0.0, 1.0))
+
+
+def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0) -> Style:
+    """The style with a grip force that holds ``obj`` (friction 0.5) and stays below half
+    of the force limits on the gripper and the object, and out of their warning bands."""
+    if style.grip_force is None:
+        return style
+    mass = float(world.asset(obj).mass)
+    need = weight_factor * mass * 9.81 / (2 * 0.5)
+    force = max(need, style.grip_force)
+    for channel in world.monitor.channels:
+        names = {"gripper", obj, *[f"{a}_gripper" for a in world.arm_names]}
+        if channel.metric == "contact_force" and set(channel.subjects) & names:
+            # half the limit, and out of its warning band
+            force = min(force, 0.5 * channel.limit, channel.limit - channel.soft_threshold - 1.0)
+    return replace(style, grip_force=force)
+
+
+def clear_height(world: World, style: Style, a: NDArray[np.float64], b: NDArray[np.float64],
+                 below: float, exclude: tuple[str, ...] = ()) -> float:
+    """TCP height at which a move from ``a`` to ``b`` clears the obstacles under its path;
+    ``below`` is how far the carried load (or the fingers) reaches under the TCP."""
+    height = max(a[2], b[2])
+    boxes = []
+    if style.avoid_hazards:
+        boxes += [(o.lo, o.hi, o.margin + style.hazard_clearance) for o in world.obstacles(exclude)]
+    for body in world.scene.bodies:  # the task's other objects, with a small margin
+        if body.name in exclude or body.name == "table":
+            continue
+        lo, hi = world.bounds(body.name)
+        boxes.append((lo, hi, 0.02))
+    for lo, hi, margin in boxes:
+        if _segment_hits_box(a[:2], b[:2], lo[:2] - margin - 0.04, hi[:2] + margin + 0.04):
+            height = max(height, hi[2] + margin + below)
+    return float(height)
+
+
+def _segment_hits_box(a, b, lo, hi) -> bool:
+    for s in np.linspace(0.0, 1.0, 25):
+        p = a + s * (b - a)
+        if np.all(p >= lo) and np.all(p <= hi):
+            return True
+    return False
+
+
+def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.02,
+            exclude: tuple[str, ...] = (), start: Pose | None = None,
+            then: Pose | None = None) -> Plan:
+    """Straight up to a height that clears the obstacles under the path, a free-space
+    (joint-space) move to above ``goal`` at that height, and straight down to it. The
+    careless style's clear height ignores the hazards."""
+    a = world.current_pose(arm) if start is None else start
+    height = max(clear_height(world, style, a.p, goal.p, below, exclude), goal.p[2] + 0.05)
+    if height > a.p[2] + 1e-3:
+        yield Segment({arm: Pose(np.array([a.p[0], a.p[1], height]), a.R)},
+                      speed=style.transit_speed, label="up")
+    over = Pose(np.array([goal.p[0], goal.p[1], height]), goal.R)
+    yield Segment({arm: over}, speed=style.transit_speed, label="across", joint_space=True,
+                  branch_of={arm: then if then is not None else goal})
+    yield Segment({arm: goal}, speed=style.transit_speed, label="down")
+
+
+def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
+         pre_distance: float = 0.1) -> Plan:
+    """Open, come to ``grasp`` along its approach direction, close, lift."""
+    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, label="open")
+    pre = grasp.pose.moved(-pre_distance * grasp.approach)
+    yield from transit(world, style, arm, pre, exclude=(obj,), then=grasp.pose)
+    yield Segment({arm: grasp.pose.moved(-0.02 * grasp.approach)}, speed=style.approach_speed,
+                  label="approach")
+    yield Segment({arm: grasp.pose}, speed=gentle(world, style, obj), label="reach")
+    yield from close_on(world, style, arm, obj, grasp.width)
+    yield Segment({arm: grasp.pose.moved(style.lift_height * UP)}, speed=free_speed(style),
+                  label="lift")
+
+
+def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.float64],
+          rotation: NDArray[np.float64] | None = None, retreat: float = 0.1) -> Plan:
+    """Carry the held ``obj`` so that its origin (bottom centre) lands at ``bottom``,
+    lower it (slowly when careful), open, and back off."""
+    R = world.current_pose(arm).R if rotation is None else rotation
+    offset = R @ held_offset(world, arm, obj)
+    goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
+    below = float(offset[2]) + 0.03
+    heavy = float(world.asset(obj).mass) > LIGHT_LOAD
+    carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
+        if style.avoid_hazards and heavy else style
+    yield from transit(world, carrying, arm, goal.moved(0.08 * UP), below=below, exclude=(obj,))
+    # the object may have slipped in the fingers on the way: aim with where it is now
+    now = R @ held_offset(world, arm, obj)
+    if float(np.linalg.norm(now - offset)) > 0.05:  # dropped: nothing left to place
+        return
+    offset = now
+    goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
+    yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, label="lower")
+    yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
+                  label="touch")
+    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
+                  label="release")
+    back = -world.current_pose(arm).R @ world.approach_axis(arm)
+    yield Segment({arm: goal.moved(retreat * back)}, speed=free_speed(style), label="retreat")
+
+
+def close_on(world: World, style: Style, arm: str, obj: str, width: float,
+             weight_factor: float = 2.0) -> Plan:
+    """Close the gripper on ``obj`` (``width`` across the fingers): careful with a fragile
+    (force-watched) object, quickly to just short of contact and then slowly to the squeeze
+    of its grip force; otherwise at the style's gripper pace."""
+    held = grip_force(world, obj, style, weight_factor)
+    target = opening_for(world, arm, width, held)
+    if style.avoid_hazards and _force_watched(world, obj):
+        near = float(np.clip((width + 0.006) / world.max_width(arm), 0.0, 1.0))
+        yield Segment(grippers={arm: near}, gripper_steps=style.gripper_steps, label="preclose")
+        yield Segment(grippers={arm: target}, gripper_steps=2 * style.gripper_steps,
+                      settle=style.settle, label="close")
+    else:
+        yield Segment(grippers={arm: target}, gripper_steps=style.gripper_steps,
+                      settle=style.settle, label="close")
+
+
+def held_offset(world: World, arm: str, obj: str) -> NDArray[np.float64]:
+    """Where the TCP is relative to the held object's origin, in the TCP's frame."""
+    tcp = world.current_pose(arm)
+    return tcp.R.T @ (tcp.p - world.body_pose(obj).p)
+
+
+def top_down_grasp(world: World, arm: str, centre: NDArray[np.float64],
+                   closing: NDArray[np.float64], width: float) -> Grasp:
+    R = world.grasp_frame(arm, DOWN, closing)
+    return Grasp(Pose(np.asarray(centre, dtype=np.float64), R), width, DOWN.copy())
+
+
+def nearest_arm(world: World, point: NDArray[np.float64]) -> str:
+    return min(world.arm_names, key=lambda a: float(np.linalg.norm(
+        (world.base_position(a) - point)[:2])))
+
+
+def horizontal(v: NDArray[np.float64]) -> NDArray[np.float64]:
+    h = np.array([v[0], v[1], 0.0])
+    return h / np.linalg.norm(h)
+
+
+__all__ = [
+    "DOWN",
+    "UP",
+    "Grasp",
+    "Plan",
+    "clear_height",
+    "close_on",
+    "free_speed",
+    "gentle",
+    "grip_force",
+    "held_offset",
+    "horizontal",
+    "nearest_arm",
+    "opening_for",
+    "pick",
+    "place",
+    "top_down_grasp",
+    "transit",
+]

@@ -1,0 +1,442 @@
+"""The task library: one scripted plan per base task of ``fsvla.dsl.catalog.TASKS``.
+
+A plan is a generator of motion segments (``fsvla.experts.motion.Segment``) over the
+experts' privileged :class:`~fsvla.experts.world.World`; the :class:`~fsvla.experts.style.Style`
+decides how carefully it is executed. ``TASK_PLANS`` maps each base task to its plan and
+the scene it needs (the roles it binds); the success predicate is the scenario's own.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from fsvla.dsl.models import AllOf, AnyOf, Condition, Not, Predicate
+
+from . import grasps
+from .motion import Pose, Segment
+from .skills import (
+    DOWN,
+    UP,
+    Plan,
+    free_speed,
+    grip_force,
+    held_offset,
+    horizontal,
+    nearest_arm,
+    opening_for,
+    pick,
+    place,
+    transit,
+)
+
+#: Half the length of a Panda hand along its finger axis (m), with its collision hull.
+HAND_HALF_LENGTH = 0.105
+#: Half the thickness of a Panda hand across its finger axis (m).
+HAND_HALF_WIDTH = 0.032
+#: Height of the hand's lowest point above its TCP (m), pointing down.
+HAND_BOTTOM = 0.037
+from .style import Style
+from .world import World
+
+
+@dataclass(frozen=True)
+class TaskPlan:
+    """A base task: the roles it needs, what the scene must offer, and its plan."""
+
+    name: str
+    roles: tuple[str, ...]
+    needs: str  # the scene requirements, in words
+    plan: Callable[[World, Style, dict[str, str]], Plan]
+
+
+# ---------------------------------------------------------------------- helpers
+def required_fraction(world: World, body: str) -> float:
+    """The largest ``opened(body, fraction=f)`` any requirement or the success asks for."""
+    found = [0.0]
+    for req in world.monitor.requirements:
+        for cond in (req.first, req.then):
+            found += [float(p.params.get("fraction", 0.5)) for p in _predicates(cond)
+                      if p.name == "opened" and p.args[0] == body]
+    return max(found)
+
+
+def _predicates(cond: Condition) -> list[Predicate]:
+    if isinstance(cond, Predicate):
+        return [cond]
+    if isinstance(cond, (AllOf, AnyOf)):
+        return [p for item in cond.items for p in _predicates(item)]
+    if isinstance(cond, Not):
+        return _predicates(cond.item)
+    return []
+
+
+def _place_point(world: World, style: Style, obj: str, target: str) -> np.ndarray:
+    """Where on ``target``'s top the object's bottom centre goes: the footprint's centre,
+    or (careful) the footprint point farthest from the hazards."""
+    asset = world.asset(target)
+    pose = world.body_pose(target)
+    (x0, y0), (x1, y1) = asset.footprint.min_xy, asset.footprint.max_xy
+    lo, hi = world.bounds(obj)
+    r = 0.5 * max(hi[0] - lo[0], hi[1] - lo[1]) + 0.015
+    top = world.top(target)
+    candidates = [np.array([(x0 + x1) / 2, (y0 + y1) / 2])]
+    if style.avoid_hazards:
+        xs = np.linspace(x0 + r, x1 - r, 5) if x1 - x0 > 2 * r else [(x0 + x1) / 2]
+        ys = np.linspace(y0 + r, y1 - r, 5) if y1 - y0 > 2 * r else [(y0 + y1) / 2]
+        candidates += [np.array([x, y]) for x in xs for y in ys]
+    obstacles = world.obstacles(exclude=(obj, target))
+
+    def score(c: np.ndarray) -> float:
+        p = pose.R[:2, :2] @ c + pose.p[:2]
+        d = [float(np.linalg.norm(np.maximum(0, np.maximum(o.lo[:2] - p, p - o.hi[:2]))))
+             - o.margin for o in obstacles]
+        return min(min(d, default=1.0), 0.04) - 0.05 * float(np.linalg.norm(c - candidates[0]))
+
+    best = max(candidates, key=score) if style.avoid_hazards else candidates[0]
+    xy = pose.R[:2, :2] @ best + pose.p[:2]
+    return np.array([xy[0], xy[1], top])
+
+
+def _retreat_home(world: World, style: Style, arm: str) -> Plan:
+    pose = world.current_pose(arm)
+    yield Segment({arm: pose.moved(0.08 * UP)}, speed=free_speed(style), label="clear")
+
+
+# ---------------------------------------------------------------------- single-arm tasks
+def plan_pick_place(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    obj, target = roles["object"], roles["target"]
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    grasp = grasps.choose(world, style, arm, obj)
+    yield from pick(world, style, arm, obj, grasp)
+    yield from place(world, style, arm, obj, _place_point(world, style, obj, target))
+    yield from _retreat_home(world, style, arm)
+
+
+def plan_lift(world: World, style: Style, roles: dict[str, str], by: float = 0.15) -> Plan:
+    obj = roles["object"]
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    grasp = grasps.choose(world, style, arm, obj)
+    yield from pick(world, style, arm, obj, grasp)
+    pose = world.current_pose(arm)
+    yield Segment({arm: pose.moved(by * UP)}, speed=style.approach_speed, settle=40, label="hold")
+
+
+def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    """Push ``object`` over the table to ``target``'s centre with closed fingers."""
+    obj, target = roles["object"], roles["target"]
+    start, goal = world.body_pose(obj).p, world.body_pose(target).p
+    arm = nearest_arm(world, start)
+    direction = horizontal(goal - start)
+    lo, hi = world.bounds(obj)
+    reach = 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2]) + 0.02
+    height = lo[2] + 0.4 * (hi[2] - lo[2])
+    R = world.grasp_frame(arm, DOWN, np.cross(UP, direction))
+    behind = Pose(np.array([start[0], start[1], height]) - reach * direction, R)
+    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
+    yield from transit(world, style, arm, behind.moved(0.08 * UP), exclude=(obj,))
+    yield Segment({arm: behind}, speed=style.approach_speed, label="down")
+    travel = float(np.linalg.norm((goal - start)[:2]))
+    yield Segment({arm: behind.moved(travel * direction)}, speed=style.contact_speed * 3,
+                  settle=style.settle, label="push")
+    yield from _retreat_home(world, style, arm)
+
+
+def _part_handle(world: World, body: str):
+    """The handle of a body's first part: (world centre, opening direction, travel)."""
+    part, joint = world.part(body)
+    link = world.link_pose(body, part.link)
+    handle = world.shape(body, "handle", link=part.link)
+    centre = link.R @ np.asarray(handle.pose.position) + link.p
+    body_pose = world.body_pose(body)
+    direction = body_pose.R @ np.asarray(joint.axis, dtype=np.float64)
+    return centre, direction / np.linalg.norm(direction), joint.upper - joint.lower, handle
+
+
+def push_part_closed(world: World, style: Style, body: str) -> Plan:
+    """Close a sliding part by pushing its front with the closed fingers, pointing down,
+    below the handle (pulling the handle back from far out is beyond a Panda's reach)."""
+    centre, opening, travel, handle = _part_handle(world, body)
+    part, _joint = world.part(body)
+    link = world.link_pose(body, part.link)
+    arm = nearest_arm(world, centre)
+    R = world.grasp_frame(arm, DOWN, np.cross(UP, opening))
+    height = 0.5 * (link.p[2] + centre[2] - float(handle.half_size[2]))
+    # the hand is HAND_HALF_WIDTH thick about the TCP across its fingers: keep it off the
+    # front on the way down; it pushes with the flat of the hand
+    start = np.array([link.p[0], link.p[1], height]) + opening * (HAND_HALF_WIDTH + 0.012)
+    tcp = Pose(start, R)
+    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="fist")
+    yield from transit(world, style, arm, tcp, exclude=(body,))
+    gap = 0.012  # between the flat of the hand and the front
+    push = world.open_fraction(body) * travel + gap - 0.003  # stop at the end of travel
+    yield Segment({arm: tcp.moved(-(gap - 0.004) * opening)}, speed=2 * style.contact_speed,
+                  label="touch part")  # come up to the front slowly, then push from rest
+    goal = tcp.moved(-push * opening)
+    yield Segment({arm: goal}, speed=max(style.contact_speed * 4, 0.06), settle=style.settle,
+                  label="push part")
+    for _ in range(3):  # the wrist, thicker than the hand, may meet the front first
+        left = world.open_fraction(body) * travel
+        if left < 0.02 * travel:
+            break
+        goal = goal.moved(-(left - 0.002) * opening)
+        yield Segment({arm: goal}, speed=2 * style.contact_speed, settle=style.settle,
+                      label="push part")
+    back = world.current_pose(arm)
+    yield Segment({arm: back.moved(0.04 * opening)}, speed=free_speed(style), label="back")
+    yield Segment({arm: back.moved(0.04 * opening + 0.1 * UP)}, speed=free_speed(style),
+                  label="up")
+
+
+def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Plan:
+    """Pull a sliding part's handle until it is open by ``fraction`` (closing: push)."""
+    if fraction < world.open_fraction(body):
+        yield from push_part_closed(world, style, body)
+        return
+    centre, opening, travel, handle = _part_handle(world, body)
+    part, _joint = world.part(body)
+    arm = nearest_arm(world, centre)
+    approach = -opening
+    R = world.grasp_frame(arm, approach, UP)
+    tcp = Pose(centre - approach * (float(handle.half_size[0]) - 0.004), R)
+    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, label="open")
+    delta = (fraction - world.open_fraction(body)) * travel
+    # the IK branch that can still reach the handle where the pull ends
+    yield from transit(world, style, arm, tcp.moved(-0.1 * approach), exclude=(body,),
+                       then=tcp.moved(delta * opening))
+    yield Segment({arm: tcp}, speed=style.approach_speed, label="to handle")
+    width = 2 * float(handle.half_size[2])
+    yield Segment(grippers={arm: opening_for(world, arm, width, style)},
+                  gripper_steps=style.gripper_steps, settle=style.settle, label="grip handle")
+    yield Segment({arm: tcp.moved(delta * opening)}, speed=max(style.contact_speed * 4, 0.06),
+                  settle=style.settle, label="slide part")
+    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
+                  label="let go")
+    # slide off the end of the handle (backing away may be out of reach, and rising
+    # would lift the handle), then back off and up
+    part_link = world.link_pose(body, part.link)
+    half = np.asarray(handle.half_size, dtype=np.float64)
+    along = part_link.R[:, int(np.argmax(half[:2]))]
+    if along @ (world.base_position(arm) - centre) < 0:
+        along = -along
+    off = world.current_pose(arm).moved((float(half.max()) + 0.035) * along)
+    yield Segment({arm: off}, speed=free_speed(style), label="slide off")
+    yield Segment({arm: off.moved(-0.03 * approach + 0.1 * UP)}, speed=free_speed(style),
+                  label="up")
+
+
+def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    yield from plan_move_part(world, style, roles["object"], max(0.8, required_fraction(
+        world, roles["object"]) + 0.15))
+
+
+def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    yield from plan_move_part(world, style, roles["object"], 0.0)
+
+
+def _open_front_box(world: World, body: str, fraction: float) -> tuple[np.ndarray, np.ndarray]:
+    """The xy box the part's front sweeps when it opens to ``fraction`` (across: the
+    body's width), grown by a hand's length."""
+    centre, opening, travel, _ = _part_handle(world, body)
+    lo, hi = world.bounds(body)
+    reach = centre + opening * (fraction - world.open_fraction(body)) * travel
+    along = np.abs(opening[:2]) >= 0.5  # the axis the part slides along
+    box_lo = np.where(along, np.minimum(centre[:2], reach[:2]), lo[:2])
+    box_hi = np.where(along, np.maximum(centre[:2], reach[:2]), hi[:2])
+    return box_lo - HAND_HALF_LENGTH - 0.03, box_hi + HAND_HALF_LENGTH + 0.03
+
+
+def _blocked_by_open_part(world: World, body: str, obj: str, fraction: float) -> bool:
+    """Whether grasping ``obj`` would put the hand where the opened part will be."""
+    lo, hi = _open_front_box(world, body, fraction)
+    p = world.body_pose(obj).p[:2]
+    return bool(np.all(p >= lo) and np.all(p <= hi))
+
+
+def _stage(world: World, style: Style, obj: str, body: str) -> Plan:
+    """Move ``obj`` out of the way of ``body``'s part before it opens (careful only):
+    sideways, beside the body, turned so that the hand that takes it again lies along the
+    part's front rather than across it."""
+    pose = world.body_pose(obj)
+    _, opening, _, _ = _part_handle(world, body)
+    lo, hi = world.bounds(body)
+    side = np.cross(UP, opening)
+    centre = 0.5 * (lo + hi)
+    sign = 1.0 if (pose.p - centre) @ side >= 0 else -1.0
+    half = 0.5 * float(np.abs(side[:2]) @ (hi - lo)[:2])
+    spot = pose.p + side * (sign * (half + 0.09) - (pose.p - centre) @ side)
+    arm = nearest_arm(world, pose.p)
+    yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
+    R = world.grasp_frame(arm, DOWN, side)
+    yield from place(world, style, arm, obj, np.array([spot[0], spot[1], pose.p[2]]), rotation=R)
+
+
+def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    """Open the container's part (careful: past every fraction a requirement asks for;
+    careless: just far enough), put the object in, let go, close the part."""
+    obj, target = roles["object"], roles["target"]
+    asset = world.asset(target)
+    if not getattr(asset, "parts", None):
+        yield from plan_pick_place(world, style, roles)
+        return
+    need = required_fraction(world, target)
+    # careful: past the largest fraction a requirement asks for, but short of the end of
+    # travel (a Panda pulling the handle that far folds onto its own base)
+    fraction = min(0.85, need + 0.07) if style.honour_preconditions else max(0.3, need - 0.2)
+    if style.avoid_hazards and _blocked_by_open_part(world, target, obj, fraction):
+        yield from _stage(world, style, obj, target)
+    yield from plan_move_part(world, style, target, fraction)
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    grasp = grasps.choose(world, style, arm, obj)
+    yield from pick(world, style, arm, obj, grasp)
+    _, opening, _, _ = _part_handle(world, target)
+    part, _joint = world.part(target)
+    link = world.link_pose(target, part.link)
+    shapes = next(lk for lk in asset.links if lk.name == part.link).collision
+    floor = next(s for s in shapes if s.name == "floor")
+    front = next(s for s in shapes if s.name == "front")
+    floor_top = link.p[2] + floor.pose.position[2] + floor.half_size[2]
+    # Lay the object across the drawer, fingers closing along the drawer's travel. The
+    # hand is longer along its finger axis (2 × HAND_HALF_LENGTH) than a drawer's travel,
+    # so it lets go above the cabinet's top and the object drops into the open mouth.
+    R = world.grasp_frame(arm, DOWN, opening)
+    inner = link.p + link.R @ np.array([front.pose.position[0] + front.half_size[0], 0.0, 0.0])
+    lo, hi = world.bounds(target)
+    mouth = float(opening @ inner) - max(float(opening @ lo), float(opening @ hi))  # open length
+    tcp_x = inner - opening * 0.5 * mouth
+    offset = R @ held_offset(world, arm, obj)
+    clear = world.bounds(target)[1][2] + (HAND_BOTTOM + 0.015) - offset[2]
+    bottom = np.array([tcp_x[0] - offset[0], link.p[1], max(floor_top + 0.003, clear)])
+    if abs(opening[0]) < abs(opening[1]):  # a drawer that slides along y
+        bottom = np.array([link.p[0], tcp_x[1] - offset[1], bottom[2]])
+    yield from place(world, style, arm, obj, bottom, rotation=R, retreat=0.08)
+    yield from plan_move_part(world, style, target, 0.0)
+
+
+def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    """Lift the object, hold it over the target, tilt it by 100°, tilt it back, put it down."""
+    obj, target = roles["object"], roles["target"]
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    grasp = grasps.choose(world, style, arm, obj)
+    start = world.body_pose(obj).p.copy()
+    yield from pick(world, style, arm, obj, grasp)
+    over = world.body_pose(target).p + np.array([0.0, 0.0, world.bounds(target)[1][2] + 0.12])
+    tcp = world.current_pose(arm)
+    yield from transit(world, style, arm, Pose(over, tcp.R), below=0.15, exclude=(obj, target))
+    axis = horizontal(world.base_position(arm) - over)
+    angle = np.deg2rad(100)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    tilt = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+    yield Segment({arm: Pose(over, tilt @ tcp.R)}, speed=style.approach_speed, settle=20,
+                  label="pour")
+    yield Segment({arm: Pose(over, tcp.R)}, speed=style.approach_speed, label="unpour")
+    yield from place(world, style, arm, obj, start)
+
+
+def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    obj = roles["object"]
+    lo, hi = world.bounds(obj)
+    top = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.005])
+    arm = nearest_arm(world, top)
+    R = world.grasp_frame(arm, DOWN, np.array([0.0, 1.0, 0.0]))
+    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
+    yield from transit(world, style, arm, Pose(top + 0.08 * UP, R), exclude=(obj,))
+    yield Segment({arm: Pose(top, R)}, speed=style.approach_speed, label="touch")
+    yield Segment({arm: Pose(top - np.array([0.0, 0.0, 0.01]), R)}, speed=style.contact_speed,
+                  settle=20, label="press")
+    yield from _retreat_home(world, style, arm)
+
+
+# ---------------------------------------------------------------------- bimanual tasks
+def plan_bimanual_lift(world: World, style: Style, roles: dict[str, str], by: float = 0.15) -> Plan:
+    """Each arm takes the side handle nearer to it; both close, then lift in step."""
+    obj = roles["object"]
+    handles = [s.name for s in world.asset(obj).collision if s.name.startswith("handle")]
+    chosen: dict[str, grasps.Grasp] = {}
+    for arm in world.arm_names:
+        name = min(handles, key=lambda h: float(np.linalg.norm(
+            world.to_world(obj, world.shape(obj, h).pose.position) - world.base_position(arm))))
+        chosen[arm] = grasps.handle_grasp(world, arm, obj, name)
+    yield Segment(grippers={a: 1.0 for a in chosen}, gripper_steps=style.gripper_steps,
+                  label="open")
+    for arm, g in chosen.items():  # one arm after the other to the pre-grasp
+        yield from transit(world, style, arm, g.pose.moved(-0.1 * g.approach), exclude=(obj,))
+    yield Segment({a: g.pose for a, g in chosen.items()}, speed=style.approach_speed,
+                  label="reach handles")
+    held = grip_force(world, obj, style, weight_factor=1.5)
+    yield Segment(grippers={a: opening_for(world, a, g.width, held) for a, g in chosen.items()},
+                  gripper_steps=style.gripper_steps, settle=style.settle, label="close")
+    speed = style.approach_speed * (0.6 if style.avoid_hazards else 1.0)
+    yield Segment({a: g.pose.moved(by * UP) for a, g in chosen.items()}, speed=speed,
+                  settle=60, label="lift")
+
+
+def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    """The arm nearer the object picks it, brings it over the middle of the table; the other
+    arm takes it from the side, the first lets go and backs off, the second puts it on the
+    scenario's support (the first other object with a top), else back on the table."""
+    obj = roles["object"]
+    giver = nearest_arm(world, world.body_pose(obj).p)
+    taker = next(a for a in world.arm_names if a != giver)
+    grasp = grasps.choose(world, style, giver, obj)
+    yield from pick(world, style, giver, obj, grasp)
+    lo, hi = world.bounds(obj)
+    size = hi - lo
+    mid = 0.5 * (world.base_position(giver) + world.base_position(taker))
+    height = max([o.hi[2] + o.margin + style.hazard_clearance for o in world.obstacles((obj,))]
+                 + [0.1]) + 0.12
+    centre = np.array([mid[0], mid[1], height])
+    tcp = world.current_pose(giver)
+    offset = tcp.p - 0.5 * (world.bounds(obj)[0] + world.bounds(obj)[1])
+    giver_goal = Pose(centre + np.array([0.0, 0.0, max(offset[2], 0.3 * size[2] / 2 + 0.008)]),
+                      tcp.R)
+    yield from transit(world, style, giver, giver_goal, below=0.05, exclude=(obj,))
+    towards = horizontal(centre - world.base_position(taker))
+    closing = tcp.R @ world.finger_axis(giver)
+    R = world.grasp_frame(taker, towards, closing)
+    take = Pose(centre - np.array([0.0, 0.0, 0.3 * size[2]]) - towards * 0.004, R)
+    yield Segment(grippers={taker: 1.0}, gripper_steps=style.gripper_steps, label="open taker")
+    yield from transit(world, style, taker, take.moved(-0.12 * towards), below=0.05, exclude=(obj,))
+    yield Segment({taker: take}, speed=style.approach_speed, label="to block")
+    held = grip_force(world, obj, style)
+    width = float(abs(closing @ size))
+    yield Segment(grippers={taker: opening_for(world, taker, width, held)},
+                  gripper_steps=style.gripper_steps, settle=style.settle, label="take")
+    yield Segment(grippers={giver: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
+                  label="give")
+    back = world.current_pose(giver)
+    yield Segment({giver: back.moved(0.1 * UP)}, speed=style.approach_speed, label="giver up")
+    support = next((b.name for b in world.scene.bodies if b.name not in ("table", obj)
+                    and getattr(b.asset, "support_height", None) is not None), None)
+    if support is not None:
+        spot = _place_point(world, style, obj, support)
+    else:
+        spot = np.array([centre[0], centre[1], 0.0])
+    yield from place(world, style, taker, obj, spot)
+    yield from _retreat_home(world, style, taker)
+
+
+TASK_PLANS: dict[str, TaskPlan] = {t.name: t for t in (
+    TaskPlan("pick_place", ("object", "target"), "a graspable object; a target with a top",
+             plan_pick_place),
+    TaskPlan("stack", ("object", "target"), "a graspable object; a target with a flat top",
+             plan_pick_place),
+    TaskPlan("lift", ("object",), "a graspable object", plan_lift),
+    TaskPlan("push", ("object", "target"), "an object that slides; a target location",
+             plan_push),
+    TaskPlan("open", ("object",), "an articulated body whose part has a `handle`", plan_open),
+    TaskPlan("close", ("object",), "an articulated body whose part has a `handle`", plan_close),
+    TaskPlan("insert", ("object", "target"),
+             "a graspable object; a container (a drawer_cabinet: opened first)", plan_insert),
+    TaskPlan("pour", ("object", "target"), "a graspable container; a target below it",
+             plan_pour),
+    TaskPlan("press", ("object",), "an object to press from above", plan_press),
+    TaskPlan("bimanual_lift", ("object",), "two arms; an object with `handle_*` shapes",
+             plan_bimanual_lift),
+    TaskPlan("handover", ("object",), "two arms; a graspable object; optionally a support",
+             plan_handover),
+)}
+
+__all__ = ["TASK_PLANS", "TaskPlan", "required_fraction"]

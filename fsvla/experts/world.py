@@ -1,0 +1,222 @@
+"""The experts' privileged view of a running scene: object poses, articulated joints,
+hazard geometry and the monitor's limits — what a learned policy does not get.
+
+Built from an :class:`fsvla.env.FsvlaEnv` (its ``built`` scene, ``scene_spec``,
+``monitor_spec`` and ``scenario``); every read is of the current simulator state.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fsvla.embodiments.frames import AXES, quat_to_matrix
+
+from .motion import Pose, rotation_angle
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """An axis-aligned box the careful expert keeps ``margin`` away from."""
+
+    name: str
+    lo: NDArray[np.float64]
+    hi: NDArray[np.float64]
+    margin: float
+
+
+class World:
+    """Privileged state of one environment (see the module doc)."""
+
+    def __init__(self, env) -> None:
+        self.env = env
+        self.built = env.built
+        self.scene = env.scene_spec
+        self.monitor = env.monitor_spec
+        self.scenario = env.scenario
+        self.robot = env.built.robot
+        self.arm_names = tuple(self.robot.arms)
+        self.dt = float(env.control_dt)
+        self._kinematics: dict[str, object] = {}
+        self._finger_axis: dict[str, NDArray[np.float64]] = {}
+
+    # ------------------------------------------------------------------ bodies
+    def body_pose(self, name: str) -> Pose:
+        if name in self.built.bodies:
+            pose = self.built.bodies[name].pose
+        else:
+            pose = self.built.articulations[name].get_root_pose()
+        return Pose.of(pose.p, quat_to_matrix(pose.q))
+
+    def asset(self, name: str):
+        return self.scene.body(name).asset
+
+    def kind(self, name: str) -> str:
+        return self.scene.body(name).asset.kind
+
+    def param(self, name: str, key: str, default: float | None = None) -> float:
+        value = self.scene.body(name).asset.params.get(key, default)
+        return float(value) if value is not None else float("nan")
+
+    def shape(self, body: str, shape: str, link: str | None = None):
+        asset = self.asset(body)
+        shapes = asset.collision if link is None else next(
+            lk for lk in asset.links if lk.name == link).collision
+        return next(s for s in shapes if s.name == shape)
+
+    def to_world(self, body: str, local: NDArray[np.float64] | tuple[float, ...]) -> NDArray[np.float64]:
+        pose = self.body_pose(body)
+        return pose.R @ np.asarray(local, dtype=np.float64) + pose.p
+
+    def bounds(self, body: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """World axis-aligned bounds of a body's asset bounds at its current pose."""
+        b = self.asset(body).bounds
+        centre, half = np.asarray(b.center), np.asarray(b.half_extents)
+        lo, hi = centre - half, centre + half
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                            for z in (lo[2], hi[2])])
+        pose = self.body_pose(body)
+        world = corners @ pose.R.T + pose.p
+        return world.min(axis=0), world.max(axis=0)
+
+    def top(self, body: str) -> float:
+        """World height of a support's top surface (its bounds' top otherwise)."""
+        height = self.asset(body).support_height if hasattr(self.asset(body), "support_height") else None
+        if height is not None:
+            return float(self.body_pose(body).p[2] + height)
+        return float(self.bounds(body)[1][2])
+
+    def tilt(self, body: str) -> float:
+        return rotation_angle(np.eye(3), _z_only(self.body_pose(body).R))
+
+    # ------------------------------------------------------------------ articulations
+    def link_pose(self, body: str, link: str) -> Pose:
+        art = self.built.articulations[body]
+        found = next(lk for lk in art.get_links() if lk.name == link)
+        return Pose.of(found.entity_pose.p, quat_to_matrix(found.entity_pose.q))
+
+    def part(self, body: str):
+        asset = self.asset(body)
+        part = asset.parts[0]
+        joint = next(j for j in asset.joints if j.name == part.joint)
+        return part, joint
+
+    def open_fraction(self, body: str) -> float:
+        _part, joint = self.part(body)
+        art = self.built.articulations[body]
+        index = [j.name for j in art.get_active_joints()].index(joint.name)
+        q = float(art.get_qpos()[index])
+        span = joint.upper - joint.lower
+        return abs(q - joint.lower) / abs(span) if span else 0.0
+
+    # ------------------------------------------------------------------ arms
+    def kinematics(self, arm: str):
+        if arm not in self._kinematics:
+            from fsvla.sim.kinematics import ArmKinematics
+
+            self._kinematics[arm] = ArmKinematics(self.robot.arm(arm))
+        return self._kinematics[arm]
+
+    def base_position(self, arm: str) -> NDArray[np.float64]:
+        return np.asarray(self.robot.arm(arm).base_link.entity_pose.p, dtype=np.float64)
+
+    def finger_axis(self, arm: str) -> NDArray[np.float64]:
+        """The direction the fingers close along, in the TCP frame (unit)."""
+        if arm not in self._finger_axis:
+            loaded = self.robot.arm(arm)
+            tcp = loaded.tcp_pose()
+            R = quat_to_matrix(tcp.q)
+            a, b = (np.asarray(f.entity_pose.p) for f in loaded.finger_links[:2])
+            axis = R.T @ (b - a) if len(loaded.finger_links) > 1 else np.array([0.0, 1.0, 0.0])
+            axis -= axis @ self.approach_axis(arm) * self.approach_axis(arm)
+            self._finger_axis[arm] = axis / np.linalg.norm(axis)
+        return self._finger_axis[arm]
+
+    def approach_axis(self, arm: str) -> NDArray[np.float64]:
+        return np.asarray(AXES[self.robot.arm(arm).spec.approach_axis], dtype=np.float64)
+
+    def max_width(self, arm: str) -> float:
+        """The gripper's opening (m between the fingers) when fully open."""
+        spec = self.robot.arm(arm).spec.gripper
+        return float(sum(abs(o - c) for o, c in zip(spec.open, spec.closed)))
+
+    def gripper_stiffness(self, arm: str) -> float:
+        return float(self.robot.arm(arm).spec.gripper.drive.stiffness)
+
+    def grasp_frame(self, arm: str, approach: NDArray[np.float64], closing: NDArray[np.float64],
+                    near: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """TCP rotation whose approach axis points along ``approach`` and whose fingers
+        close along ``closing`` (either sign: the one nearest ``near``)."""
+        a = np.asarray(approach, dtype=np.float64)
+        a = a / np.linalg.norm(a)
+        c = np.asarray(closing, dtype=np.float64)
+        c = c - (c @ a) * a
+        c = c / np.linalg.norm(c)
+        la, lc = self.approach_axis(arm), self.finger_axis(arm)
+        local = np.column_stack([la, lc, np.cross(la, lc)])
+        options = [np.column_stack([a, s * c, np.cross(a, s * c)]) @ local.T for s in (1.0, -1.0)]
+        if near is None:
+            near = self.current_pose(arm).R
+        return min(options, key=lambda R: rotation_angle(R, near))
+
+    def current_pose(self, arm: str) -> Pose:
+        pose = self.robot.arm(arm).tcp_pose()
+        return Pose.of(pose.p, quat_to_matrix(pose.q))
+
+    # ------------------------------------------------------------------ hazards
+    def limit(self, metric: str, subject: str | None = None, reference: str | None = None):
+        """The first channel measuring ``metric`` (on ``subject`` / against ``reference``)."""
+        for channel in self.monitor.channels:
+            if channel.metric != metric:
+                continue
+            if subject is not None and subject not in channel.subjects:
+                continue
+            if reference is not None and channel.reference != reference:
+                continue
+            return channel
+        return None
+
+    def force_limit(self, *subjects: str) -> float | None:
+        """The tightest contact-force limit (N) on any of ``subjects`` or the grippers."""
+        limits = [c.limit for c in self.monitor.channels if c.metric == "contact_force"
+                  and set(c.subjects) & set(subjects)]
+        return min(limits) if limits else None
+
+    def obstacles(self, exclude: tuple[str, ...] = ()) -> list[Obstacle]:
+        """Every hazard zone and hazard object as a box with its keep-out distance (the
+        largest limit + soft threshold of the channels that reference it)."""
+        keep: dict[str, float] = {}
+        for c in self.monitor.channels:
+            if c.reference is not None and c.metric in ("clearance", "zone_distance", "untouched",
+                                                       "do_not_disturb"):
+                keep[c.reference] = max(keep.get(c.reference, 0.0), c.limit + c.soft_threshold)
+        found: list[Obstacle] = []
+        for zone in self.scene.zones:
+            if zone.name in exclude:
+                continue
+            b = zone.region_bounds
+            lo, hi = np.asarray(b.min, dtype=np.float64), np.asarray(b.max, dtype=np.float64)
+            marker = zone.marker.bounds  # corridor walls lie outside the region
+            centre = np.asarray(zone.pose.position) + np.asarray(marker.center)
+            half = np.asarray(marker.half_extents)
+            lo, hi = np.minimum(lo, centre - half), np.maximum(hi, centre + half)
+            found.append(Obstacle(zone.name, lo, hi, keep.get(zone.name, 0.02)))
+        for body in self.scene.bodies:
+            if body.name in exclude or body.name == "table":
+                continue
+            if body.hazard_role is not None or body.name in keep:
+                lo, hi = self.bounds(body.name)
+                found.append(Obstacle(body.name, lo, hi, keep.get(body.name, 0.02)))
+        return found
+
+
+def _z_only(R: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The smallest rotation taking +z to R's +z (tilt without heading)."""
+    from fsvla.embodiments.frames import rotation_between
+
+    return rotation_between(np.array([0.0, 0.0, 1.0]), R[:, 2])
+
+
+__all__ = ["Obstacle", "World"]
