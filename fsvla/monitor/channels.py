@@ -35,7 +35,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from fsvla.compiler.monitor import METRIC_NAMES, ChannelSpec
+from fsvla.compiler.monitor import METRIC_NAMES, ChannelSpec, MonitorSpec
 
 from .geometry import MAX_DISTANCE, SceneGeometry
 from .layout import Layout
@@ -114,6 +114,16 @@ def _untouched(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeo
     return d
 
 
+DISTANCE_METRICS = frozenset({"clearance", "zone_distance", "separation", "untouched", "do_not_disturb"})
+
+
+def distance_queries(spec: MonitorSpec, layout: Layout) -> tuple[tuple[frozenset[str], frozenset[str]], ...]:
+    """The (subject frames, reference frames) distance queries of a spec's channels, for
+    :meth:`SceneGeometry.prefetch`."""
+    return tuple((layout.frames(s), layout.frames(ch.reference)) for ch in spec.channels
+                 if ch.metric in DISTANCE_METRICS and ch.reference is not None for s in ch.subjects)
+
+
 MEASURES: dict[str, Measure] = {
     "contact_force": _contact_force,
     "contact_torque": _contact_torque,
@@ -140,4 +150,4 @@ def margin(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometr
     return ch.limit - m if ch.comparison == "<=" else m - ch.limit
 
 
-__all__ = ["EXACT_BAND", "MEASURES", "TOUCH_DEPTH", "margin", "measure", "tilt_of"]
+__all__ = ["DISTANCE_METRICS", "EXACT_BAND", "MEASURES", "TOUCH_DEPTH", "distance_queries", "margin", "measure", "tilt_of"]

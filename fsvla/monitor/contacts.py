@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from fsvla.compiler.monitor import MonitorSpec
 from fsvla.compiler.scene import SceneSpec
@@ -78,8 +79,10 @@ def predicate_filter(spec: MonitorSpec, layout: Layout) -> ContactFilter:
 
 class ContactGate:
     """Whether the per-substep scan and the predicates' contact reading can find anything
-    in the next control step: one broad-phase matrix of robot-link pieces against body
-    pieces, read through masks. A filter that counts every contact of a non-robot frame
+    in the next control step: robot-link pieces against body pieces within
+    :data:`CONTACT_GATE`, tested first on frame bounds (``SceneGeometry.frame_gaps``; a
+    frame's bounds hold its pieces', so far frames rule their pieces out) and on pieces
+    only where a frame is near. A filter that counts every contact of a non-robot frame
     is never gated."""
 
     def __init__(self, geometry: SceneGeometry, scan: ContactFilter, last: ContactFilter):
@@ -90,24 +93,65 @@ class ContactGate:
         robot_any = frozenset(f for f in scan.any_pair if f.startswith("@"))
         self.scan_always = bool(scan.any_pair - robot_any) or (bool(scan) and not len(ia))
         self.last_always = bool(last.any_pair) or (bool(last) and not len(ia))
-        self.scan_rows = np.isin(ia, geometry.pieces(robot_any))
-        self.scan_cols = np.isin(ib, geometry.pieces(scan.robot_pairs))
-        self.last_cols = np.isin(ib, geometry.pieces(last.robot_pairs))
         self.wants_scan, self.wants_last = bool(scan), bool(last)
+        # Frame level: the scan's robot rows against every body, and every robot link
+        # against the bodies the scan or the predicates watch.
+        index = geometry.frame_indices
+        self._rows_all, self._cols_all = index(self.rows), index(self.cols)
+        scan_rows = np.isin(self._rows_all, index(robot_any))
+        scan_cols = np.isin(self._cols_all, index(scan.robot_pairs)) & self.wants_scan
+        last_cols = np.isin(self._cols_all, index(last.robot_pairs)) & self.wants_last
+        self._scan_rows = self._rows_all[scan_rows] if self.wants_scan and scan_rows.any() else None
+        cols = scan_cols | last_cols
+        self._cols = self._cols_all[cols]
+        self._scan_cols, self._last_cols = scan_cols[cols], last_cols[cols]
+        self._frames = self.rows | self.cols
+        n = len(index(geometry.frames))
+        self._robot_vs_cols = self._rows_all[:, None] * n + self._cols
+        self._scan_vs_all = None if self._scan_rows is None else self._scan_rows[:, None] * n + self._cols_all
+        # the piece-level test, run only where the frame-level one finds something near
+        piece_rows = np.isin(ia, geometry.pieces(robot_any))
+        self._piece_scan_cols = np.isin(ib, geometry.pieces(scan.robot_pairs)) & self.wants_scan
+        self._piece_last_cols = np.isin(ib, geometry.pieces(last.robot_pairs)) & self.wants_last
+        self._piece_rows = ia[piece_rows] if self.wants_scan and piece_rows.any() else None
+        self._ia, self._ib = ia, ib
         self._answer: tuple[int, tuple[bool, bool]] | None = None
+
+    def _pieces_near(self, check_scan: bool, check_last: bool) -> tuple[bool, bool]:
+        """The piece-level verdicts asked for (False for the others)."""
+        geometry, scan, last = self.geometry, False, False
+        if check_scan and self._piece_rows is not None:
+            scan = bool(geometry.near_pieces(self._piece_rows, self._ib, CONTACT_GATE).any())
+        check_scan = check_scan and not scan
+        cols = (self._piece_scan_cols & check_scan) | (self._piece_last_cols & check_last)
+        if cols.any():
+            touched = geometry.near_pieces(self._ia, self._ib[cols], CONTACT_GATE).any(axis=0)
+            scan = scan or (check_scan and bool((touched & self._piece_scan_cols[cols]).any()))
+            last = check_last and bool((touched & self._piece_last_cols[cols]).any())
+        return scan, last
+
+    def _near(self, flat: NDArray[np.int64]) -> NDArray[np.bool_]:
+        """Frame pairs (flat indices into frame_gaps' first two axes) within the gate."""
+        return (self.geometry.frame_gaps().reshape(-1, 3)[flat] < CONTACT_GATE).all(axis=2)
 
     def update(self) -> tuple[bool, bool]:
         """(scan substeps, read the last substep's contacts) for the next control step."""
-        version = self.geometry.version(self.rows) + self.geometry.version(self.cols)
+        version = self.geometry.version(self._frames)
         if self._answer is not None and self._answer[0] == version:
             return self._answer[1]  # nothing moved
-        near = self.geometry.near(self.rows, self.cols, CONTACT_GATE)
-        scan = self.scan_always or (self.wants_scan and bool(near[self.scan_rows].any()
-                                                             or near[:, self.scan_cols].any()))
-        last = self.last_always or (self.wants_last and bool(near[:, self.last_cols].any()))
+        scan, last = self.scan_always, self.last_always
+        if not (scan and last) and len(self._rows_all):
+            # frame bounds hold their pieces' bounds: far frames rule pieces out at once
+            touched = self._near(self._robot_vs_cols).any(axis=0)
+            maybe_scan = not scan and self.wants_scan and (
+                bool((touched & self._scan_cols).any())
+                or (self._scan_vs_all is not None and bool(self._near(self._scan_vs_all).any())))
+            maybe_last = not last and self.wants_last and bool((touched & self._last_cols).any())
+            if maybe_scan or maybe_last:  # the same verdict as a piece-level gate
+                near_scan, near_last = self._pieces_near(maybe_scan, maybe_last)
+                scan, last = scan or near_scan, last or near_last
         self._answer = (version, (scan, last))
         return scan, last
-
 
 
 __all__ = ["CONTACT_GATE", "FORCE_METRICS", "ContactGate", "contact_plan", "predicate_filter"]

@@ -5,10 +5,14 @@ pieces built by ``fsvla.compiler.collision.pieces_of`` from compiler ``Shape`` m
 bodies and zones from the SceneSpec, robot links from their SAPIEN collision shapes
 (:func:`shapes_of_sapien`). Each step :meth:`SceneGeometry.set_poses` moves the world
 axis-aligned bounds of every piece in one vectorised pass; FCL transforms are set
-lazily, only for pieces an exact query touches. :meth:`SceneGeometry.distance` visits
-the piece pairs of two groups in order of their bounds' gap and stops once that gap
-exceeds the best exact distance found, so the minimum is exact while far pairs cost
-nothing. Given ``exact_below`` it also stops once the gap reaches that value: the answer
+lazily, only for pieces an exact query touches. :meth:`SceneGeometry.prefetch` bounds
+every frame (the box around its pieces) and gives each distance query of a step the gap
+between its groups' nearest frames, in one pass; a query already that far answers with
+it. Otherwise :meth:`SceneGeometry.distance` visits the piece pairs of two groups in
+order of their bounds' gap and stops once that gap exceeds the best exact distance found
+(or, overlapping pieces found, once bounds stop overlapping: the deepest penetration),
+so the minimum is exact while far pairs cost nothing. Given ``exact_below`` it also
+stops once the gap reaches that value: the answer
 is then a lower bound no smaller than ``exact_below`` (channels pass their limit plus
 soft threshold plus ``EXACT_BAND``, so states and costs stay exact). Results are memoised
 until a frame of either group moves by more than ``POSE_TOLERANCE``.
@@ -116,6 +120,10 @@ class SceneGeometry:
         self._placed: list[int] = []  # per piece: the frame stamp its FCL transform has
         self._groups: dict[frozenset[str], NDArray[np.int64]] = {}
         self._memo: dict[tuple[frozenset[str], frozenset[str]], tuple[float, float, int]] = {}
+        self._pairs: dict[tuple[frozenset[str], frozenset[str]], tuple] = {}
+        self._batches: dict[tuple, tuple] = {}
+        self._bounds_memo: dict[frozenset[str], tuple[int, tuple[NDArray[np.float64], NDArray[np.float64]]]] = {}
+        self._prefetched: dict[tuple[frozenset[str], frozenset[str]], tuple[int, float]] = {}
         self._moves: dict[tuple[str, ...], tuple[list[int], NDArray[np.int64]]] = {}
         self._group_frames: dict[frozenset[str], NDArray[np.int64]] = {}
         self._point_memo: dict[frozenset[str], tuple[int, NDArray[np.float64]]] = {}
@@ -166,15 +174,30 @@ class SceneGeometry:
         self._moves.clear()
         self._group_frames.clear()
         self._memo.clear()
+        self._pairs.clear()
+        self._batches.clear()
+        self._prefetched.clear()
+        self._bounds_memo.clear()
         self._point_memo.clear()
         self._stamp = np.array(self._stamp, dtype=np.int64)
+        # pieces grouped by frame, for the frames' world bounds (frame_gaps)
+        order = np.argsort(self._pf, kind="stable")
+        self._by_frame = None if np.array_equal(order, np.arange(len(order))) else order
+        counts = np.bincount(self._pf, minlength=len(self.frames))
+        self._frame_starts = (np.cumsum(counts) - counts)[counts > 0]
+        self._gap_rows = {f: r for r, f in enumerate(f for f, n in zip(self.frames, counts.tolist()) if n)}
+        self._frames_dirty = True
         self._frame_points = {f: np.concatenate([self._points[i] for i in idx]) for f, idx in self._frame_pieces.items()
                               if idx}
-        self._update_bounds(np.arange(len(self._pieces)))
+        self._update_bounds()
         self._frozen = True
 
     def has(self, frame: str) -> bool:
         return bool(self._frame_pieces.get(frame))
+
+    def frame_pieces(self, frame: str) -> list[CollisionPiece]:
+        """The frame's FCL pieces (their transforms are placed lazily: call ``place``)."""
+        return [self._pieces[i] for i in self._frame_pieces.get(frame, ())]
 
     # --- moving ---------------------------------------------------------------------------
 
@@ -184,33 +207,39 @@ class SceneGeometry:
         bodies keep their FCL transforms and memoised distances."""
         if not self._frozen:
             self._freeze()
-        names = tuple(poses)
+        names = getattr(poses, "names", None) or tuple(poses)
         plan = self._moves.get(names)
         if plan is None:
             keep = [i for i, f in enumerate(names) if f in self._frame_index]
-            plan = self._moves[names] = (keep, np.array([self._frame_index[names[i]] for i in keep], dtype=np.int64))
+            frames = np.array([self._frame_index[names[i]] for i in keep], dtype=np.int64)
+            plan = self._moves[names] = (None if len(keep) == len(names) else np.array(keep, dtype=np.int64), frames)
         keep, frames = plan
         if len(frames) == 0:
             return
-        values = list(poses.values())
-        new = np.array([values[i] for i in keep], dtype=np.float64)
-        moved = np.abs(new - self._pose_array[frames]).reshape(len(frames), 16).max(axis=1) > POSE_TOLERANCE
+        stack = getattr(poses, "stack", None)
+        if stack is None:
+            values = list(poses.values())
+            stack = np.array(values if keep is None else [values[i] for i in keep], dtype=np.float64)
+        else:
+            stack = stack.astype(np.float64) if keep is None else stack[keep].astype(np.float64)
+        moved = np.abs(stack - self._pose_array[frames]).reshape(len(frames), 16).max(axis=1) > POSE_TOLERANCE
         if not moved.any():
             return
         frames = frames[moved]
-        self._pose_array[frames] = new[moved]
+        self._pose_array[frames] = stack[moved]
         self._stamp[frames] += 1
-        moved_frames = np.zeros(len(self._pose_array), dtype=bool)
-        moved_frames[frames] = True
-        self._update_bounds(np.flatnonzero(moved_frames[self._pf]))
+        self._update_bounds()
 
-    def _update_bounds(self, pieces: NDArray[np.int64]) -> None:
-        if len(pieces) == 0:
+    def _update_bounds(self) -> None:
+        """Every piece's world bounds (one pass over all pieces is cheaper than picking the
+        moved ones; the others get the same numbers again)."""
+        if not len(self._pf):
             return
-        poses = self._pose_array[self._pf[pieces]]
+        poses = self._pose_array[self._pf]
         rot = poses[:, :3, :3]
-        self._wc[pieces] = np.einsum("pij,pj->pi", rot, self._c[pieces]) + poses[:, :3, 3]
-        self._wh[pieces] = np.einsum("pij,pj->pi", np.abs(rot), self._h[pieces])
+        np.add(np.einsum("pij,pj->pi", rot, self._c), poses[:, :3, 3], out=self._wc)
+        np.einsum("pij,pj->pi", np.abs(rot), self._h, out=self._wh)
+        self._frames_dirty = True
 
     def pose(self, frame: str) -> Matrix4:
         if not self._frozen:
@@ -242,9 +271,89 @@ class SceneGeometry:
             self._groups[frames] = found
         return found
 
+    def _pair(self, a: frozenset[str], b: frozenset[str]) -> tuple[NDArray[np.int64], NDArray[np.int64],
+                                                                  NDArray[np.int64], NDArray[np.bool_]]:
+        """(a's pieces, b's pieces, the frames of both for the version, same-frame piece pairs)."""
+        key = (a, b)
+        found = self._pairs.get(key)
+        if found is None:
+            ia, ib = self._group(a), self._group(b)
+            frames = np.array([self._frame_index[f] for f in a if f in self._frame_index]
+                              + [self._frame_index[f] for f in b if f in self._frame_index], dtype=np.int64)
+            pf = np.asarray(self._piece_frame, dtype=np.int64)
+            same = (pf[ia][:, None] == pf[ib][None, :]).ravel()
+            found = self._pairs[key] = (ia, ib, frames, same)
+        return found
+
+    def prefetch(self, queries: tuple[tuple[frozenset[str], frozenset[str]], ...]) -> None:
+        """Frame-level bounds of many :meth:`distance` queries in one vectorised pass: for
+        each, the smallest gap between the world bounds of a frame of one group and a frame
+        of the other (a lower bound of the distance, and of every piece-pair bound).
+        :meth:`distance` answers with it, without a piece-level pass, when it is already at
+        least ``exact_below``."""
+        if not self._frozen:
+            self._freeze()
+        plan = self._batches.get(queries)
+        if plan is None:
+            plan = self._batches[queries] = self._batch_plan(queries)
+        keys, frames, frame_starts, flat, starts = plan
+        if not keys:
+            return
+        versions = np.add.reduceat(self._stamp[frames], frame_starts).tolist()
+        if not len(self._frame_starts):
+            return
+        gap = np.maximum(self.frame_gaps(), 0.0)
+        bound = np.sqrt(np.einsum("abk,abk->ab", gap, gap)).ravel()
+        nearest = np.minimum.reduceat(bound[flat], starts).tolist()
+        self._prefetched = dict(zip(keys, zip(versions, nearest)))
+
+    def frame_gaps(self) -> NDArray[np.float64]:
+        """(F, F, 3) for the F frames with pieces (rows: :meth:`frame_indices`): per axis,
+        the gap between the world bounds of two frames' pieces (negative where they
+        overlap on that axis), a lower bound of the gap between any of their pieces."""
+        if not self._frozen:
+            self._freeze()
+        if self._frames_dirty:
+            self._frames_dirty = False
+            lo, hi = self._wc - self._wh, self._wc + self._wh
+            if self._by_frame is not None:
+                lo, hi = lo[self._by_frame], hi[self._by_frame]
+            lo = np.minimum.reduceat(lo, self._frame_starts)
+            hi = np.maximum.reduceat(hi, self._frame_starts)
+            self._frame_gaps = np.maximum(lo[None, :, :] - hi[:, None, :], lo[:, None, :] - hi[None, :, :])
+        return self._frame_gaps
+
+    def frame_indices(self, frames: Iterable[str]) -> NDArray[np.int64]:
+        """Rows of :meth:`frame_gaps` for those of ``frames`` that have pieces (sorted)."""
+        if not self._frozen:
+            self._freeze()
+        rows = self._gap_rows
+        return np.array(sorted(rows[f] for f in frames if f in rows), dtype=np.int64)
+
+    def _batch_plan(self, queries: tuple[tuple[frozenset[str], frozenset[str]], ...]) -> tuple:
+        keys, frames, frame_starts, flat, starts = [], [], [], [], []
+        rows, count = self._gap_rows, 0
+        n_frames = len(rows)
+        for a, b in dict.fromkeys(queries):
+            ia, ib, fr, _ = self._pair(a, b)
+            if len(ia) == 0 or len(ib) == 0:
+                continue
+            fa = sorted({rows[self.frames[self._piece_frame[i]]] for i in ia})
+            fb = sorted({rows[self.frames[self._piece_frame[i]]] for i in ib})
+            keys.append((a, b))
+            frame_starts.append(count)
+            count += len(fr)
+            frames.append(fr)
+            starts.append(len(flat))
+            flat += [x * n_frames + y for x in fa for y in fb]
+        if not keys:
+            return ((), None, None, None, None)
+        return (tuple(keys), np.concatenate(frames), np.array(frame_starts, dtype=np.int64),
+                np.array(flat, dtype=np.int64), np.array(starts, dtype=np.int64))
+
     def distance(self, a: frozenset[str], b: frozenset[str], exact_below: float = MAX_DISTANCE) -> float:
         """Smallest signed distance between the pieces of two frame groups (negative when
-        they overlap: the penetration depth); MAX_DISTANCE when either has no geometry.
+        they overlap: the deepest penetration); MAX_DISTANCE when either has no geometry.
 
         The result is exact when it is below ``exact_below``; otherwise it is a lower bound
         of the distance that is itself at least ``exact_below`` (the search stops once every
@@ -252,35 +361,44 @@ class SceneGeometry:
         if not self._frozen:
             self._freeze()
         key = (a, b)
-        version = self.version(a) + self.version(b)
+        ia, ib, frames, same = self._pair(a, b)
+        version = int(self._stamp[frames].sum())
         cached = self._memo.get(key)
         if cached is not None and cached[2] == version and (cached[0] < cached[1] or cached[1] >= exact_below):
             return cached[0]
-        ia, ib = self._group(a), self._group(b)
         if len(ia) == 0 or len(ib) == 0:
             return MAX_DISTANCE
-        gap = np.abs(self._wc[ia][:, None, :] - self._wc[ib][None, :, :])
-        gap -= self._wh[ia][:, None, :] + self._wh[ib][None, :, :]
+        found = self._prefetched.get(key)
+        if found is not None and found[0] == version and found[1] >= exact_below:
+            self._memo[key] = (found[1], exact_below, version)  # far at the frame level already
+            return found[1]
+        wc, wh = self._wc, self._wh
+        gap = np.abs(wc[ia][:, None, :] - wc[ib][None, :, :])
+        gap -= wh[ia][:, None, :] + wh[ib][None, :, :]
         np.maximum(gap, 0.0, out=gap)
         bound = np.sqrt(np.einsum("abk,abk->ab", gap, gap)).ravel()
         nearest = float(bound.min())
         if nearest >= exact_below:  # every pair is far: the broad phase answers
             self._memo[key] = (nearest, exact_below, version)
             return nearest
-        order = np.argsort(bound)
         best = MAX_DISTANCE
         nb = len(ib)
-        for flat in order:
-            lower = float(bound[flat])
-            if lower >= best:
+        # Only pairs whose bounds are below exact_below can matter: sort just those.
+        candidates = np.flatnonzero(bound < exact_below)
+        candidates = candidates[np.argsort(bound[candidates], kind="stable")]
+        lowers = bound[candidates].tolist()
+        skip = same[candidates].tolist()
+        for flat, lower, same_frame in zip(candidates.tolist(), lowers, skip):
+            # a pair whose bounds are apart is at least that far; overlapping bounds
+            # (lower = 0) can still hold a deeper penetration than a negative best
+            if lower >= best and (best >= 0.0 or lower > 0.0):
                 break
-            if lower >= exact_below:
-                best = lower
-                break
-            pa, pb = ia[flat // nb], ib[flat % nb]
-            if self._piece_frame[pa] == self._piece_frame[pb]:
+            if same_frame:
                 continue
-            best = min(best, signed_distance(self._fcl(pa).obj, self._fcl(pb).obj))
+            best = min(best, signed_distance(self._fcl(ia[flat // nb]).obj, self._fcl(ib[flat % nb]).obj))
+        else:  # the pairs left are at least as far as the nearest of their bounds
+            if len(candidates) < len(bound):
+                best = min(best, float(bound[bound >= exact_below].min()))
         self._memo[key] = (best, exact_below, version)
         return best
 
@@ -297,6 +415,15 @@ class SceneGeometry:
         d = np.abs(self._wc[ia][:, None, :] - self._wc[ib][None, :, :])
         d -= self._wh[ia][:, None, :] + self._wh[ib][None, :, :]
         return np.all(d < gap, axis=2)
+
+    def near_pieces(self, ia: NDArray[np.int64], ib: NDArray[np.int64], gap: float) -> NDArray[np.bool_]:
+        """:meth:`near` for piece indices (rows ``ia``, columns ``ib``)."""
+        if not self._frozen:
+            self._freeze()
+        wc, wh = self._wc, self._wh
+        d = np.abs(wc[ia][:, None, :] - wc[ib][None, :, :])
+        d -= wh[ia][:, None, :] + wh[ib][None, :, :]
+        return (d < gap).all(axis=2)
 
     def points(self, frames: frozenset[str]) -> NDArray[np.float64]:
         """World sample points of the frames' geometry (vertices, rims of round shapes)."""
@@ -325,7 +452,13 @@ class SceneGeometry:
         idx = self._group(frames)
         if len(idx) == 0:
             return None
-        return (self._wc[idx] - self._wh[idx]).min(axis=0), (self._wc[idx] + self._wh[idx]).max(axis=0)
+        version = self.version(frames)
+        cached = self._bounds_memo.get(frames)
+        if cached is not None and cached[0] == version:
+            return cached[1]
+        found = (self._wc[idx] - self._wh[idx]).min(axis=0), (self._wc[idx] + self._wh[idx]).max(axis=0)
+        self._bounds_memo[frames] = (version, found)
+        return found
 
 
 __all__ = ["MAX_DISTANCE", "POSE_TOLERANCE", "SceneGeometry", "shapes_of_sapien"]

@@ -54,6 +54,8 @@ class Scope:
 
     def __init__(self, state: WorldState, layout: Layout, geometry: SceneGeometry):
         self.state, self.layout, self.geo = state, layout, geometry
+        self.held: dict[int, tuple[Predicate, bool]] = {}  # id(predicate) -> (it, holds): one state, one answer
+        self._centres: dict[str, np.ndarray] = {}
 
     def frames(self, name: str) -> frozenset[str]:
         return self.layout.frames(name)
@@ -70,9 +72,12 @@ class Scope:
         return self.geo.distance(a, b) <= TOUCH_DISTANCE
 
     def centre(self, body: str) -> np.ndarray:
-        lo, hi = self.layout.bodies[body].bounds
-        pose = self.root_pose(body)
-        return pose[:3, :3] @ ((lo + hi) / 2.0) + pose[:3, 3]
+        found = self._centres.get(body)
+        if found is None:
+            lo, hi = self.layout.bodies[body].bounds
+            pose = self.root_pose(body)
+            found = self._centres[body] = pose[:3, :3] @ ((lo + hi) / 2.0) + pose[:3, 3]
+        return found
 
     def point(self, entity: str) -> np.ndarray:
         frame = self.layout.reference_frames.get(entity)
@@ -107,8 +112,8 @@ def _point_in_shape(point: np.ndarray, shape: Shape) -> bool:
 
 
 def _in_box(point: np.ndarray, pose: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
-    local = (point - pose[:3, 3]) @ pose[:3, :3]
-    return bool(np.all(local >= lo) and np.all(local <= hi))
+    local = ((point - pose[:3, 3]) @ pose[:3, :3]).tolist()
+    return all(a <= x <= b for a, x, b in zip(lo.tolist(), local, hi.tolist()))
 
 
 def _param(p: Predicate, name: str) -> float:
@@ -214,7 +219,12 @@ assert set(EVALUATORS) == set(PREDICATES), "every catalog predicate needs an eva
 def holds(condition: Condition, scope: Scope) -> bool:
     """Whether a condition tree holds in the scope's state."""
     if isinstance(condition, Predicate):
-        return EVALUATORS[condition.name](condition, scope)
+        known = scope.held.get(id(condition))
+        if known is not None and known[0] is condition:
+            return known[1]
+        value = EVALUATORS[condition.name](condition, scope)
+        scope.held[id(condition)] = (condition, value)
+        return value
     if isinstance(condition, AllOf):
         return all(holds(item, scope) for item in condition.items)
     if isinstance(condition, AnyOf):

@@ -29,10 +29,11 @@ from typing import Any
 
 import numpy as np
 
-from .state import ContactMaxima, Matrix4, WorldState, link_frame, robot_frame
+from .state import ContactMaxima, PoseMap, WorldState, link_frame, robot_frame
 
 #: The "other side" of a body's net contact force in ContactMaxima keys.
 NET = "*"
+_ZERO = [0.0, 0.0, 0.0]
 
 
 def _rigid_component(entity: Any) -> Any:
@@ -91,7 +92,22 @@ class _FreeBody:
         self.weight = tuple(self.mass * g for g in gravity)
         self.inertia = tuple(float(v) for v in component.inertia)
         self.cmass_q = tuple(component.cmass_local_pose.q.tolist())  # principal axes in the body frame
+        self._rest: tuple[float, tuple[float, float]] | None = None
         self.read()
+
+    def _magnitudes(self, v: list[float], w: list[float] | None, inv_dt: float) -> tuple[float, float]:
+        """(force, torque) of :meth:`record` for readings ``v``, ``w`` equal to the last ones."""
+        m = self.mass * inv_dt
+        fx, fy, fz = (m * (a - b) - g for a, b, g in zip(v, self.v, self.weight))
+        force = math.sqrt(fx * fx + fy * fy + fz * fz)
+        if w is None:
+            return force, 0.0
+        ix, iy, iz = self.inertia
+        lx, ly, lz = ix * w[0], iy * w[1], iz * w[2]
+        tx = ix * (w[0] - self.w[0]) * inv_dt + w[1] * lz - w[2] * ly
+        ty = iy * (w[1] - self.w[1]) * inv_dt + w[2] * lx - w[0] * lz
+        tz = iz * (w[2] - self.w[2]) * inv_dt + w[0] * ly - w[1] * lx
+        return force, math.sqrt(tx * tx + ty * ty + tz * tz)
 
     def read(self) -> None:
         self.v = self.c.linear_velocity.tolist()
@@ -112,6 +128,16 @@ class _FreeBody:
                 2 * (x * z + w * y) * ox + 2 * (y * z - w * x) * oy + (1 - 2 * (x * x + y * y)) * oz]
 
     def record(self, maxima: ContactMaxima, inv_dt: float) -> None:
+        if self.c.is_sleeping and self.v == _ZERO and (not self.torque or self.w == _ZERO):
+            # PhysX zeroes a sleeping body's velocities: the readings would be what they
+            # were (zero), so the maxima get the same values without the reads
+            if self._rest is None or self._rest[0] != inv_dt:
+                self._rest = (inv_dt, self._magnitudes(_ZERO, _ZERO if self.torque else None, inv_dt))
+            force, torque = self._rest[1]
+            maxima.add_force(self.frame, NET, force)
+            if self.torque:
+                maxima.add_torque(self.frame, NET, torque)
+            return
         v = self.c.linear_velocity.tolist()
         m = self.mass * inv_dt
         fx, fy, fz = (m * (a - b) - g for a, b, g in zip(v, self.v, self.weight))
@@ -142,6 +168,8 @@ class Probe:
         self.components = dict(components)
         self._frame_of = {id(c): f for f, c in self.components.items()}
         self._pose_frames = [(f, self.components[f]) for f in pose_frames if f in self.components]
+        self._pose_names = tuple(f for f, _ in self._pose_frames)
+        self._pose_components = [c for _, c in self._pose_frames]
         self._torque = frozenset(torque_frames)
         g = (float(gravity[0]), float(gravity[1]), float(gravity[2]))
         self._free = [_FreeBody(f, self.components[f], g, f in self._torque) for f in free_bodies
@@ -150,6 +178,10 @@ class Probe:
         self._last = last
         self._joints = dict(joints or {})  # "<body>:<joint>" -> (articulation, qpos index)
         self.maxima = ContactMaxima()
+        # (id(body0), id(body1)) -> their frames if the scan keeps the pair, else None; the
+        # bodies are the components above and the scene's other bodies, alive as long as it
+        self._scan_pairs: dict[tuple[int, int], tuple[str, str] | None] = {}
+        self._scan_hot, self._last_hot = self._hot(scan), self._hot(last)
         self.scan = True  # the per-substep pair scan runs
         self.read_last = True  # snapshot(contacts=True) reads the last substep's contacts
 
@@ -174,15 +206,32 @@ class Probe:
         if self.scan and self._filter:
             self._scan(inv_dt)
 
+    def _pair(self, b0: Any, b1: Any, wants: Any) -> tuple[str, str] | None:
+        """The frames of a contact's bodies when ``wants`` keeps the pair, else None."""
+        f0, f1 = self._frame_of.get(id(b0)), self._frame_of.get(id(b1))
+        if not wants(f0, f1):
+            return None
+        return f0 or f"?{b0.entity.name}", f1 or f"?{b1.entity.name}"
+
+    def _hot(self, filter: ContactFilter) -> frozenset[int]:
+        """ids of the components a kept pair must involve (one side is in the filter)."""
+        frames = filter.any_pair | filter.robot_pairs
+        return frozenset(id(c) for f, c in self.components.items() if f in frames)
+
     def _scan(self, inv_dt: float) -> None:
-        frame_of, wants, maxima, torque = self._frame_of.get, self._filter.wants, self.maxima, self._torque
+        maxima, torque, cache, wants = self.maxima, self._torque, self._scan_pairs, self._filter.wants
+        hot = self._scan_hot
         for contact in self._scene.get_contacts():
             b0, b1 = contact.bodies
-            f0, f1 = frame_of(id(b0)), frame_of(id(b1))
-            if not wants(f0, f1):
+            if id(b0) not in hot and id(b1) not in hot:
                 continue
-            f0 = f0 or f"?{b0.entity.name}"
-            f1 = f1 or f"?{b1.entity.name}"
+            key = (id(b0), id(b1))
+            frames = cache.get(key, False)
+            if frames is False:
+                frames = cache[key] = self._pair(b0, b1, wants)
+            if frames is None:
+                continue
+            f0, f1 = frames
             points = contact.points
             impulse = sum((p.impulse for p in points), np.zeros(3))
             magnitude = float(np.sqrt(impulse @ impulse)) * inv_dt
@@ -198,9 +247,11 @@ class Probe:
         """Force on the first frame by the second, for the wanted contacts of the last substep."""
         forces: dict[tuple[str, str], np.ndarray] = {}
         inv_dt = 1.0 / self._dt
-        frame_of, wants = self._frame_of.get, self._last.wants
+        frame_of, wants, hot = self._frame_of.get, self._last.wants, self._last_hot
         for contact in self._scene.get_contacts():
             b0, b1 = contact.bodies
+            if id(b0) not in hot and id(b1) not in hot:
+                continue
             f0, f1 = frame_of(id(b0)), frame_of(id(b1))
             if not wants(f0, f1):
                 continue
@@ -211,13 +262,22 @@ class Probe:
             forces[(f1, f0)] = forces.get((f1, f0), np.zeros(3)) - force
         return forces
 
-    def poses(self) -> dict[str, Matrix4]:
-        return {f: c.entity_pose.to_transformation_matrix() for f, c in self._pose_frames}
+    def poses(self) -> PoseMap:
+        if not self._pose_frames:
+            return PoseMap((), np.zeros((0, 4, 4), dtype=np.float32))
+        return PoseMap(self._pose_names, np.array([c.entity_pose.to_transformation_matrix()
+                                                   for c in self._pose_components]))
 
     def snapshot(self, step: int, time: float, *, contacts: bool = False) -> WorldState:
         """The world now, with the maxima recorded since the last snapshot (which are then
         cleared); ``contacts`` also reads the last substep's wanted contact forces."""
-        joints = {k: float(a.get_qpos()[i]) for k, (a, i) in self._joints.items()}
+        qpos: dict[int, Any] = {}
+        joints = {}
+        for k, (a, i) in self._joints.items():
+            q = qpos.get(id(a))
+            if q is None:
+                q = qpos[id(a)] = a.get_qpos()
+            joints[k] = float(q[i])
         state = WorldState(step=step, time=time, poses=self.poses(), joints=joints,
                            contact_force=dict(self.maxima.force), contact_torque=dict(self.maxima.torque),
                            last_contacts=self.last_contacts() if contacts and self.read_last else {},

@@ -25,9 +25,9 @@ def step_costs(margins: NDArray[np.float64], soft_thresholds: NDArray[np.float64
                shapings: Sequence[str]) -> NDArray[np.float64]:
     """c_k = g_k(max(0, ε_k - q_k) / ε_k) per channel, as ``fsvla.metrics.shaping.soft_cost``."""
     x = np.maximum(0.0, soft_thresholds - margins) / soft_thresholds
-    costs = np.empty_like(x)
-    for k, name in enumerate(shapings):
-        costs[k] = SHAPING_FUNCTIONS[name](x[k:k + 1])[0]
+    costs = np.zeros_like(x)  # g(0) = 0 for every shaping: only channels below ε cost
+    for k in np.flatnonzero(x).tolist():
+        costs[k] = SHAPING_FUNCTIONS[shapings[k]](x[k:k + 1])[0]
     return costs
 
 
@@ -53,7 +53,7 @@ class StepReport:
     @property
     def any_violation(self) -> bool:
         """Whether some channel is past its hard limit (q_k < 0) at this step."""
-        return bool(np.any(self.margins < 0.0))
+        return "violation" in self.states
 
     violation = any_violation
 
@@ -72,7 +72,7 @@ class StepReport:
         return {
             "cost": self.cost,
             "violation": self.any_violation,
-            "margins": dict(zip(self.names, map(float, self.margins))),
+            "margins": dict(zip(self.names, self.margins.tolist())),
             "states": dict(zip(self.names, self.states)),
             "success": self.success,
         }

@@ -42,6 +42,15 @@ def pair_key(a: str, b: str) -> Pair:
     return (a, b) if a <= b else (b, a)
 
 
+class PoseMap(dict):
+    """Frame -> 4x4 pose, read in one pass: ``stack`` holds the matrices in ``names`` order
+    (the values are views of it), so the geometry takes them without re-stacking."""
+
+    def __init__(self, names: tuple[str, ...], stack: NDArray[np.floating]):
+        super().__init__(zip(names, stack))
+        self.names, self.stack = names, stack
+
+
 @dataclass
 class ContactMaxima:
     """Running maxima over the substeps of one control step."""
@@ -107,4 +116,4 @@ class WorldState:
         return total
 
 
-__all__ = ["ContactMaxima", "Matrix4", "Pair", "WorldState", "link_frame", "pair_key", "robot_frame"]
+__all__ = ["ContactMaxima", "Matrix4", "Pair", "PoseMap", "WorldState", "link_frame", "pair_key", "robot_frame"]

@@ -1,0 +1,269 @@
+"""Cost of the safety monitor per control step, for every built-in scenario.
+
+For each concrete scenario in ``scenarios/`` two state-only ``joint_pos`` environments
+are built, one with the monitor and one without (``fsvla.make(..., monitor=False)``),
+and driven by the same deterministic, moving action sequence:
+
+- ``sweep``: every arm joint follows its own sinusoid about home (0.3–0.6 rad), the
+  gripper opens and closes every 2 s; the links sweep through the space over the table;
+- ``reach``: each arm's TCP goes, top-down, from home to above the task object (the
+  success condition's first body), down to its top, closes the gripper, lifts, and back
+  (joint targets solved once by IK, so the env step has no IK in it).
+
+Both environments step in lockstep, one control step each in turn (the order alternates),
+so each pair of steps has the same action and physical state and load from other
+processes hits both alike. Reported per scenario and motion: the median env step with
+the monitor off and on, the median of the paired differences and its ratio to the off
+step (the target: at most 15 %), and the monitor's own time per control step (its 25
+``record_substep`` calls and ``end_step``, timed in every other pair, which is then left
+out of the env-step figures).
+
+    python bench/monitor.py [--steps 300] [--motions sweep,reach] [--only NAME]
+
+Exit status 0 whatever the verdict: this is a benchmark.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, Self
+
+import numpy as np
+from fsvla.dsl.models import AllOf, AnyOf, Not, Predicate
+
+import fsvla
+from fsvla.library import builtin_scenarios
+from fsvla.sim.kinematics import ArmKinematics
+
+TARGET = 0.15  # the monitor may add at most this fraction to a state-only env step
+EPISODE = 200  # control steps before both envs reset (untimed)
+WARMUP = 10
+
+
+# --------------------------------------------------------------------------- motions
+
+def sweep_actions(env: Any, length: int) -> np.ndarray:
+    """Each arm joint on its own sinusoid about home; the gripper opens and closes."""
+    dt = env.control_dt
+    low, high = env.action_space.low.astype(np.float64), env.action_space.high.astype(np.float64)
+    t = np.arange(length)[:, None] * dt
+    blocks = []
+    for k, arm in enumerate(env.built.robot.arms.values()):
+        home = np.asarray(arm.spec.home, dtype=np.float64)
+        n = len(home)
+        amplitude = np.array([0.5, 0.35, 0.3, 0.4, 0.5, 0.5, 0.6, 0.5, 0.5][:n])
+        period = np.array([4.0, 3.0, 5.0, 3.5, 2.5, 4.5, 2.0, 3.0, 3.0][:n])
+        phase = 0.7 * np.arange(n) + 1.3 * k
+        joints = home + amplitude * np.sin(2 * np.pi * t / period + phase)
+        gripper = 0.5 + 0.5 * np.sin(2 * np.pi * t / 2.0 + k)
+        blocks += [joints, gripper]
+    actions = np.concatenate(blocks, axis=1)
+    return np.clip(actions, low, high).astype(np.float32)
+
+
+def _first_body(condition: Any, bodies: set[str]) -> str | None:
+    if isinstance(condition, Predicate):
+        return next((a for a in condition.args if a in bodies), None)
+    items = condition.items if isinstance(condition, (AllOf, AnyOf)) else (
+        (condition.item,) if isinstance(condition, Not) else ())
+    return next((b for b in (_first_body(i, bodies) for i in items) if b), None)
+
+
+def _object_top(env: Any, name: str) -> np.ndarray:
+    body = next(b for b in env.scene_spec.bodies if b.name == name)
+    bounds = body.asset.bounds
+    centre = np.asarray(body.pose.position) + np.asarray(bounds.center)
+    return centre + np.array([0.0, 0.0, bounds.half_extents[2]])
+
+
+def reach_actions(env: Any, length: int) -> np.ndarray:
+    """Top-down reach to the task object, grasp, lift, back home: joint targets by IK."""
+    dt = env.control_dt
+    low, high = env.action_space.low.astype(np.float64), env.action_space.high.astype(np.float64)
+    bodies = {b.name for b in env.scene_spec.bodies if not b.is_static}
+    target = _first_body(env.monitor_spec.success.condition, bodies) or min(bodies)
+    top = _object_top(env, target)
+    cycle = 6.0  # s: approach 2, descend 1, grasp 0.5, lift 1, return 1.5
+    blocks = []
+    for k, arm in enumerate(env.built.robot.arms.values()):
+        kin = ArmKinematics(arm)
+        home_q = np.asarray(arm.spec.home, dtype=np.float64)
+        home_p = np.asarray(kin.tcp_pose(home_q).p, dtype=np.float64)
+        down = kin.top_down()
+        goal = top + np.array([0.0, 0.06 * (1 - 2 * k) if len(env.built.robot.arms) > 1 else 0.0, 0.0])
+        above = goal + np.array([0.0, 0.0, 0.15])
+        keys = [(0.0, home_p, 1.0), (2.0, above, 1.0), (3.0, goal, 1.0), (3.5, goal, 0.0),
+                (4.5, above, 0.0), (6.0, home_p, 1.0)]
+        waypoints = []  # (time, joints, gripper), every 0.25 s, IK seeded by the previous answer
+        seed = home_q
+        for s in np.arange(0.0, cycle + 1e-9, 0.25):
+            i = max(j for j, key in enumerate(keys) if key[0] <= s + 1e-9)
+            t0, p0, g0 = keys[i]
+            t1, p1, g1 = keys[min(i + 1, len(keys) - 1)]
+            a = 0.0 if t1 == t0 else (s - t0) / (t1 - t0)
+            position = p0 + a * (p1 - p0)
+            seed = kin.inverse(tuple(position), down, seed=seed, restarts=2).qpos
+            waypoints.append((s, seed, g0 + a * (g1 - g0)))
+        times = np.array([w[0] for w in waypoints])
+        q = np.array([w[1] for w in waypoints])
+        g = np.array([w[2] for w in waypoints])
+        t = (np.arange(length) * dt) % cycle
+        joints = np.stack([np.interp(t, times, q[:, j]) for j in range(q.shape[1])], axis=1)
+        blocks += [joints, np.interp(t, times, g)[:, None]]
+    actions = np.concatenate(blocks, axis=1)
+    return np.clip(actions, low, high).astype(np.float32)
+
+
+MOTIONS: dict[str, Callable[[Any, int], np.ndarray]] = {"sweep": sweep_actions, "reach": reach_actions}
+
+
+# --------------------------------------------------------------------------- timing
+
+class Runner:
+    """One env stepping through a fixed action sequence, resetting every EPISODE steps."""
+
+    def __init__(self, env: Any, actions: np.ndarray):
+        self.env, self.actions, self.t = env, actions, 0
+
+    def step(self) -> float:
+        """One control step; its wall time (s)."""
+        if self.t >= EPISODE:
+            self.env.reset()
+            self.t = 0
+        action = self.actions[self.t]
+        start = time.perf_counter()
+        self.env.step(action)
+        elapsed = time.perf_counter() - start
+        self.t += 1
+        return elapsed
+
+
+class MonitorProbe:
+    """Times a monitor's record_substep and end_step by shadowing them on the instance."""
+
+    def __init__(self, monitor: Any):
+        self.monitor = monitor
+        self.record_substep, self.end_step = monitor.record_substep, monitor.end_step
+        self.substep_acc = 0.0
+        self.substep: list[float] = []
+        self.end: list[float] = []
+
+    def _timed_substep(self) -> None:
+        start = time.perf_counter()
+        self.record_substep()
+        self.substep_acc += time.perf_counter() - start
+
+    def _timed_end(self) -> Any:
+        start = time.perf_counter()
+        report = self.end_step()
+        self.end.append(time.perf_counter() - start)
+        self.substep.append(self.substep_acc)
+        self.substep_acc = 0.0
+        return report
+
+    def __enter__(self) -> Self:
+        self.monitor.record_substep, self.monitor.end_step = self._timed_substep, self._timed_end
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        del self.monitor.record_substep, self.monitor.end_step  # back to the class's methods
+        self.substep_acc = 0.0
+
+
+@dataclass(frozen=True)
+class Row:
+    scenario: str
+    motion: str
+    off_ms: float
+    on_ms: float
+    added_ms: float  # median of the paired differences (on - off at the same control step)
+    substep_ms: float
+    end_ms: float
+
+    @property
+    def ratio(self) -> float:
+        return self.added_ms / self.off_ms
+
+    @property
+    def monitor_ms(self) -> float:
+        return self.substep_ms + self.end_ms
+
+
+def measure(name: str, off: Any, on: Any, motion: str, steps: int) -> Row:
+    """Both envs step in lockstep (the same action at the same control step, so the same
+    physical state); the order within a pair alternates, and every other pair the
+    monitored env runs with probes on its monitor instead of being timed."""
+    actions = MOTIONS[motion](off, EPISODE)
+    runner_off, runner_on = Runner(off, actions), Runner(on, actions)
+    for runner in (runner_off, runner_on):
+        runner.env.reset()
+        for _ in range(WARMUP):
+            runner.step()
+    probe = MonitorProbe(on.monitor)
+    off_ms, on_ms, added = [], [], []
+    for i in range(2 * steps):
+        if i % 2:  # a probe pair: the monitored env's step is not timed as a whole
+            first, second = (runner_on, runner_off) if i % 4 == 1 else (runner_off, runner_on)
+            with probe:
+                first.step()
+                second.step()
+            continue
+        if i % 4 == 0:
+            a, b = runner_off.step(), runner_on.step()
+        else:
+            b, a = runner_on.step(), runner_off.step()
+        off_ms.append(a * 1e3)
+        on_ms.append(b * 1e3)
+        added.append((b - a) * 1e3)
+    return Row(name, motion, statistics.median(off_ms), statistics.median(on_ms), statistics.median(added),
+               statistics.median(probe.substep) * 1e3, statistics.median(probe.end) * 1e3)
+
+
+def table(rows: Sequence[Row]) -> str:
+    head = (f"{'scenario':<26} {'motion':<6} {'off ms':>7} {'on ms':>7} {'added':>7} {'ratio':>7} "
+            f"{'monitor':>8} {'substeps':>9} {'end_step':>9}  vs 15%")
+    lines = [head, "-" * len(head)]
+    for r in rows:
+        mark = "ok" if r.ratio <= TARGET else "OVER"
+        lines.append(f"{r.scenario:<26} {r.motion:<6} {r.off_ms:7.3f} {r.on_ms:7.3f} {r.added_ms:7.3f} "
+                     f"{r.ratio:7.1%} {r.monitor_ms:8.3f} {r.substep_ms:9.3f} {r.end_ms:9.3f}  {mark}")
+    return "\n".join(lines)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--steps", type=int, default=300, help="timed control steps per env, scenario and motion")
+    parser.add_argument("--motions", default="sweep,reach", help="comma-separated: " + ", ".join(MOTIONS))
+    parser.add_argument("--only", action="append", default=None, help="a scenario name (repeatable)")
+    args = parser.parse_args(argv)
+    motions = [m for m in args.motions.split(",") if m]
+    unknown = [m for m in motions if m not in MOTIONS]
+    if unknown:
+        parser.error(f"unknown motion {', '.join(unknown)}; choose from {', '.join(MOTIONS)}")
+    names = args.only or list(builtin_scenarios())
+    started = time.perf_counter()
+    rows = []
+    for name in names:
+        off, on = fsvla.make(name, monitor=False), fsvla.make(name, monitor=True)
+        for motion in motions:
+            rows.append(measure(name, off, on, motion, args.steps))
+            print(table(rows[-1:]).splitlines()[-1], flush=True)
+    print()
+    print("per control step (ms, medians): env step with the monitor off / on, the difference, its ratio")
+    print("to the off step; the monitor's own time = its 25 record_substep calls + end_step")
+    print(table(rows))
+    worst = max(rows, key=lambda r: r.ratio)
+    over = [r for r in rows if r.ratio > TARGET]
+    verdict = "PASS" if not over else f"FAIL ({len(over)} of {len(rows)} over)"
+    print(f"\nverdict: {verdict}: the monitor adds at most {worst.ratio:.1%} "
+          f"({worst.scenario}, {worst.motion}) to a state-only env step; target {TARGET:.0%}"
+          f"  [{time.perf_counter() - started:.0f} s]")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
