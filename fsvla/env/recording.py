@@ -83,7 +83,8 @@ class EpisodeRecorder:
         return EpisodeRecord(
             channels=self.channels,
             action_labels=self.action_labels,
-            actions=np.array(self._actions, dtype=np.float64).reshape(len(reports), -1),
+            actions=np.array(self._actions, dtype=np.float64).reshape(len(reports),
+                                                                     len(self.action_labels)),
             margins=np.array([r.margins for r in reports], dtype=np.float64).reshape(len(reports), k),
             states=tuple(tuple(r.states) for r in reports),
             costs=np.array([r.costs for r in reports], dtype=np.float64).reshape(len(reports), k),

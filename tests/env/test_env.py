@@ -170,3 +170,10 @@ def test_an_episode_after_contact_replays_exactly(short_scenario: Path) -> None:
     first, second = push(), push()
     assert first[0][:, 1].min() < 0  # the push really made contact (a force violation)
     assert np.array_equal(first[0], second[0]) and np.array_equal(first[1], second[1])
+
+
+def test_the_record_of_an_episode_without_steps_is_empty(env: FsvlaEnv) -> None:
+    env.reset(seed=0)
+    record = env.episode_record()
+    assert record.steps == 0 and record.actions.shape == (0, len(env.codec.labels))
+    assert record.margins.shape == (0, 2) and not record.success
