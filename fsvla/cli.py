@@ -350,6 +350,11 @@ from .runner.commands import replay_command, run_command
 main.add_command(run_command)
 main.add_command(replay_command)
 
+# `fsvla collect`: demonstrations as a LeRobot dataset.
+from .collect.command import collect_command  # noqa: E402
+
+main.add_command(collect_command)
+
 
 def run(argv: Iterable[str] | None = None) -> int:
     """Run the CLI and return its exit code instead of exiting (for tests and embedding)."""
