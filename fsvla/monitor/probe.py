@@ -17,6 +17,12 @@ control step is never missed):
   only while :attr:`Probe.scan` is set (the monitor clears it while no watched robot
   link is near anything, see ``fsvla.monitor.monitor``).
 
+SAPIEN's contact list holds each shape pair's latest PhysX report, and a pair is
+reported again only while one of its bodies is awake and a touch wakes a sleeping body.
+So while every *guard body* of a filter (its frames: each kept pair involves one) slept
+through a substep, a reading would find what the previous one found: the probe skips it
+and reuses that reading (:attr:`Probe.guards`; the argument is in ``docs/monitor.md``).
+
 A contact's impulses act on its first body; the second gets their opposite.
 """
 
@@ -164,6 +170,7 @@ class Probe:
                  joints: Mapping[str, tuple[Any, int]] | None = None,
                  gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)):
         self._scene = scene
+        self._physx = getattr(scene, "physx_system", scene)
         self._dt = float(timestep)
         self.components = dict(components)
         self._frame_of = {id(c): f for f, c in self.components.items()}
@@ -182,8 +189,16 @@ class Probe:
         # bodies are the components above and the scene's other bodies, alive as long as it
         self._scan_pairs: dict[tuple[int, int], tuple[str, str] | None] = {}
         self._scan_hot, self._last_hot = self._hot(scan), self._hot(last)
+        self._scan_guard, self._last_guard = self._guard(scan), self._guard(last)
+        # What the last reading found, valid while every guard body sleeps (see _asleep):
+        # the scan's (kind, frame, other, value) records, and the last-substep forces.
+        self._scan_memo: list[tuple[str, str, str, float]] | None = None
+        self._scan_memo_counted = False  # its records are in this control step's maxima
+        self._last_memo: dict[tuple[str, str], np.ndarray] | None = None
+        self._scan_slept = self._last_slept = False  # guards asleep after the previous substep
         self.scan = True  # the per-substep pair scan runs
         self.read_last = True  # snapshot(contacts=True) reads the last substep's contacts
+        self.guards = True  # sleeping guard bodies spare the scans (off: every reading is taken)
 
     @property
     def records_substeps(self) -> bool:
@@ -195,6 +210,8 @@ class Probe:
     def reset(self) -> None:
         """Forget the maxima and re-read velocities (after the scene was reset)."""
         self.maxima.clear()
+        self._scan_memo = self._last_memo = None
+        self._scan_slept = self._last_slept = False
         for body in self._free:
             body.read()
 
@@ -204,7 +221,24 @@ class Probe:
         for body in self._free:
             body.record(self.maxima, inv_dt)
         if self.scan and self._filter:
-            self._scan(inv_dt)
+            slept = self._scan_slept
+            self._scan_slept = asleep = self.guards and _asleep(self._scan_guard)
+            if slept and asleep and self._scan_memo is not None:
+                # every contact a scan keeps touches a guard body, and a body asleep all
+                # through the substep had no contact reported: the scan would read the
+                # same contacts as the last one
+                if not self._scan_memo_counted:
+                    self._replay(self._scan_memo)
+            else:
+                self._scan_memo = self._scan(inv_dt)
+            self._scan_memo_counted = True
+        else:
+            self._scan_memo, self._scan_slept = None, False
+        if self.read_last and self._last:
+            # the last-substep reading may be reused only if its guards slept all along
+            self._last_slept = self._last_slept and self.guards and _asleep(self._last_guard)
+        else:
+            self._last_memo, self._last_slept = None, False
 
     def _pair(self, b0: Any, b1: Any, wants: Any) -> tuple[str, str] | None:
         """The frames of a contact's bodies when ``wants`` keeps the pair, else None."""
@@ -213,17 +247,42 @@ class Probe:
             return None
         return f0 or f"?{b0.entity.name}", f1 or f"?{b1.entity.name}"
 
-    def _hot(self, filter: ContactFilter) -> frozenset[int]:
-        """ids of the components a kept pair must involve (one side is in the filter)."""
-        frames = filter.any_pair | filter.robot_pairs
-        return frozenset(id(c) for f, c in self.components.items() if f in frames)
+    def _guard(self, filter: ContactFilter) -> tuple[tuple[Any, str], ...] | None:
+        """Components every kept pair involves whose sleep can be read (free rigid bodies,
+        links), or None when one of them is static (never asleep) or not in the scene."""
+        if not self.guards_possible(filter):
+            return None
+        return tuple((self.components[f], _sleep_flag(self.components[f]))
+                     for f in sorted(filter.any_pair | filter.robot_pairs))
 
-    def _scan(self, inv_dt: float) -> None:
+    def guards_possible(self, filter: ContactFilter) -> bool:
+        """Whether the sleep of the filter's bodies can spare its readings."""
+        frames = filter.any_pair | filter.robot_pairs
+        if not frames or any(f not in self.components for f in frames):
+            return False
+        return all(_sleep_flag(self.components[f]) is not None for f in frames)
+
+    def _replay(self, records: list[tuple[str, str, str, float]]) -> None:
+        maxima = self.maxima
+        for kind, a, b, value in records:
+            if kind == "f":
+                maxima.add_force(a, b, value)
+            else:
+                maxima.add_torque(a, b, value)
+
+    def _hot(self, filter: ContactFilter) -> set[Any]:
+        """The components a kept pair must involve (one side is in the filter), compared by
+        identity (SAPIEN hands out one Python object per live component)."""
+        frames = filter.any_pair | filter.robot_pairs
+        return {c for f, c in self.components.items() if f in frames}
+
+    def _scan(self, inv_dt: float) -> list[tuple[str, str, str, float]]:
+        """Fold the wanted contacts into the maxima; returns what it folded in."""
         maxima, torque, cache, wants = self.maxima, self._torque, self._scan_pairs, self._filter.wants
-        hot = self._scan_hot
-        for contact in self._scene.get_contacts():
+        hot, records = self._scan_hot, []
+        for contact in self._contacts():
             b0, b1 = contact.bodies
-            if id(b0) not in hot and id(b1) not in hot:
+            if b0 not in hot and b1 not in hot:  # identity: a component's wrapper is unique
                 continue
             key = (id(b0), id(b1))
             frames = cache.get(key, False)
@@ -238,19 +297,38 @@ class Probe:
             if magnitude <= 0.0:
                 continue
             maxima.add_force(f0, f1, magnitude)
+            records.append(("f", f0, f1, magnitude))
             if f0 in torque:
-                maxima.add_torque(f0, f1, _torque_about(b0, points, inv_dt))
+                value = _torque_about(b0, points, inv_dt)
+                maxima.add_torque(f0, f1, value)
+                records.append(("t", f0, f1, value))
             if f1 in torque:
-                maxima.add_torque(f1, f0, _torque_about(b1, points, inv_dt))
+                value = _torque_about(b1, points, inv_dt)
+                maxima.add_torque(f1, f0, value)
+                records.append(("t", f1, f0, value))
+        return records
+
+    def _contacts(self) -> list[Any]:
+        return self._physx.get_contacts()
 
     def last_contacts(self) -> dict[tuple[str, str], np.ndarray]:
-        """Force on the first frame by the second, for the wanted contacts of the last substep."""
+        """Force on the first frame by the second, for the wanted contacts of the last
+        substep. Reused from the last reading while its guard bodies slept through every
+        substep since (their contacts were not reported again)."""
+        if self._last_slept and self._last_memo is not None and self.guards:
+            return {k: v.copy() for k, v in self._last_memo.items()}
+        forces = self._read_last()
+        self._last_slept = self.guards and _asleep(self._last_guard)
+        self._last_memo = {k: v.copy() for k, v in forces.items()}
+        return forces
+
+    def _read_last(self) -> dict[tuple[str, str], np.ndarray]:
         forces: dict[tuple[str, str], np.ndarray] = {}
         inv_dt = 1.0 / self._dt
         frame_of, wants, hot = self._frame_of.get, self._last.wants, self._last_hot
-        for contact in self._scene.get_contacts():
+        for contact in self._contacts():
             b0, b1 = contact.bodies
-            if id(b0) not in hot and id(b1) not in hot:
+            if b0 not in hot and b1 not in hot:
                 continue
             f0, f1 = frame_of(id(b0)), frame_of(id(b1))
             if not wants(f0, f1):
@@ -283,7 +361,31 @@ class Probe:
                            last_contacts=self.last_contacts() if contacts and self.read_last else {},
                            contacts_read=contacts or self.records_substeps)
         self.maxima.clear()
+        self._scan_memo_counted = False
         return state
+
+
+def _sleep_flag(component: Any) -> str | None:
+    """The attribute that says whether a component is asleep: ``is_sleeping`` (a dynamic
+    rigid body), ``sleeping`` (an articulation link); None for a static body, and for a
+    kinematic one (a touch does not wake it)."""
+    if getattr(component, "kinematic", False):
+        return None
+    kind = type(component)
+    for name in ("is_sleeping", "sleeping"):
+        if hasattr(kind, name):
+            return name
+    return None
+
+
+def _asleep(guard: tuple[tuple[Any, str], ...] | None) -> bool:
+    """Whether every guard body is asleep (False without guards)."""
+    if not guard:
+        return False
+    for component, flag in guard:
+        if not getattr(component, flag):
+            return False
+    return True
 
 
 def _torque_about(body: Any, points: Any, inv_dt: float) -> float:

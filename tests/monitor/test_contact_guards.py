@@ -1,0 +1,96 @@
+"""Sleeping guard bodies spare contact readings without changing a single number.
+
+The probe skips a substep's contact scan (and reuses the last substep's contacts for the
+predicates) while every body its kept pairs must involve sleeps (``fsvla.monitor.probe``).
+Here each built-in scenario runs the benchmark's ``reach`` and ``sweep`` motions with two
+monitors on one scene, one with the guards and one reading every contact; their force
+maxima, last-substep contacts and margins must be bit-identical at every control step.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("sapien")
+
+import fsvla
+from fsvla.library import builtin_scenarios
+from fsvla.monitor import SafetyMonitor
+
+pytestmark = pytest.mark.sim
+STEPS = 130  # one reach cycle (6 s) and a little more
+BENCH = Path(__file__).resolve().parents[2] / "bench" / "monitor.py"
+
+
+def _motions():
+    spec = importlib.util.spec_from_file_location("fsvla_bench_monitor", BENCH)
+    module = sys.modules.get(spec.name)
+    if module is None:
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[spec.name] = module  # its dataclasses look their module up
+        spec.loader.exec_module(module)
+    return module.MOTIONS
+
+
+def _record_readings(monitor: SafetyMonitor, into: list) -> None:
+    """Keep what each snapshot folds in: force and torque maxima, last-substep contacts."""
+    probe = monitor.probe
+    snapshot = probe.snapshot
+
+    def recorded(step, time, *, contacts=False):
+        state = snapshot(step, time, contacts=contacts)
+        into.append((dict(state.contact_force), dict(state.contact_torque),
+                     {k: v.tolist() for k, v in state.last_contacts.items()}))
+        return state
+
+    probe.snapshot = recorded
+
+
+@pytest.mark.parametrize("motion", ["reach", "sweep"])
+@pytest.mark.parametrize("name", sorted(builtin_scenarios()))
+def test_guards_read_what_a_full_scan_reads(name, motion):
+    env = fsvla.make(name, monitor=True)
+    actions = _motions()[motion](env, STEPS)
+    env.reset()
+    guarded = env.monitor
+    full = SafetyMonitor(env.monitor_spec, env.built)
+    full.probe.guards = False
+    full.reset()
+    a, b = [], []
+    _record_readings(guarded, a)
+    _record_readings(full, b)
+    scans = {guarded: 0, full: 0}
+    for monitor in scans:
+        scan = monitor.probe._scan
+
+        def counted(inv_dt, scan=scan, monitor=monitor):
+            scans[monitor] += 1
+            return scan(inv_dt)
+
+        monitor.probe._scan = counted
+    record, end = guarded.record_substep, guarded.end_step
+    margins = []
+
+    def record_both():
+        record()
+        full.record_substep()
+
+    def end_both():
+        report = end()
+        margins.append((report.margins, full.end_step().margins))
+        return report
+
+    guarded.record_substep, guarded.end_step = record_both, end_both
+    for action in actions:
+        env.step(action)
+    assert len(a) == len(b) == STEPS
+    for step, (x, y) in enumerate(zip(a, b)):
+        assert x == y, (name, motion, step)
+    for step, (x, y) in enumerate(margins, start=1):
+        assert np.array_equal(x, y), (name, motion, step)
+    assert scans[guarded] <= scans[full]
