@@ -62,9 +62,13 @@ def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
         return found[0]
 
     def clearance(g: Grasp) -> float:
-        p = g.pose.p
+        # the TCP and the two ends of the hand (21 cm long along the finger axis, its
+        # body above the TCP): a hand lying toward a hazard reaches into its keep-out
+        closing = g.pose.R @ world.finger_axis(arm)
+        body = g.pose.p - 0.06 * g.approach
+        points = (g.pose.p, body + HAND_HALF_LENGTH * closing, body - HAND_HALF_LENGTH * closing)
         return min(float(np.linalg.norm(np.maximum(0, np.maximum(o.lo - p, p - o.hi))))
-                   for o in obstacles)
+                   - o.margin for o in obstacles for p in points)
 
     return max(found, key=clearance)
 
@@ -89,6 +93,8 @@ def _cylinder(world: World, arm: str, obj: str) -> list[Grasp]:
 
 
 UPV = np.array([0.0, 0.0, 1.0])
+#: Half the length of a Panda hand along its finger axis (m), with its collision hull.
+HAND_HALF_LENGTH = 0.105
 #: The hand's body reaches down to 37 mm above the TCP: a top-down TCP stays this far
 #: (m) below an object's top, so that the palm clears it by 9 mm.
 HAND_DEPTH = 0.028

@@ -94,6 +94,8 @@ def clear_height(world: World, style: Style, a: NDArray[np.float64], b: NDArray[
     for body in world.scene.bodies:  # the task's other objects, with a small margin
         if body.name in exclude or body.name == "table":
             continue
+        if body.hazard_role is not None and not style.avoid_hazards:
+            continue  # careless: a hazard object is not an obstacle
         lo, hi = world.bounds(body.name)
         boxes.append((lo, hi, 0.02))
     for lo, hi, margin in boxes:
@@ -115,10 +117,14 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
             then: Pose | None = None) -> Plan:
     """Straight up to a height that clears the obstacles under the path, a free-space
     (joint-space) move to above ``goal`` at that height, and straight down to it. The
-    careless style's clear height ignores the hazards."""
+    careless style's clear height ignores the hazards (zones and hazard objects), and
+    where no task object is in the way it moves in one diagonal line to above ``goal``."""
     a = world.current_pose(arm) if start is None else start
-    height = max(clear_height(world, style, a.p, goal.p, below, exclude), goal.p[2] + 0.05)
-    if height > a.p[2] + 1e-3:
+    clear = clear_height(world, style, a.p, goal.p, below, exclude)
+    height = max(clear, goal.p[2] + 0.05)
+    # careless: a diagonal line to above the goal unless a task object is in the way
+    direct = not style.avoid_hazards and clear <= max(a.p[2], goal.p[2]) + 1e-3
+    if height > a.p[2] + 1e-3 and not direct:
         yield Segment({arm: Pose(np.array([a.p[0], a.p[1], height]), a.R)},
                       speed=style.transit_speed, label="up")
     over = Pose(np.array([goal.p[0], goal.p[1], height]), goal.R)
@@ -158,12 +164,16 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     if float(np.linalg.norm(now - offset)) > 0.05:  # dropped: nothing left to place
         return
     offset = now
-    goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
+    fragile = style.avoid_hazards and _force_watched(world, obj)
+    # a fragile object is set down (not dropped from the release height: a 2 mm drop of a
+    # 100 g block lands with ~9 N over one 2 ms substep), then let go slowly
+    drop = 0.0 if fragile else style.release_height
+    goal = Pose(bottom + offset + np.array([0.0, 0.0, drop]), R)
     yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, label="lower")
     yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
                   label="touch")
-    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
-                  label="release")
+    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps * (2 if fragile else 1),
+                  settle=style.settle, label="release")
     back = -world.current_pose(arm).R @ world.approach_axis(arm)
     yield Segment({arm: goal.moved(retreat * back)}, speed=free_speed(style), label="retreat")
 

@@ -29,6 +29,7 @@ from .skills import (
     opening_for,
     pick,
     place,
+    top_down_grasp,
     transit,
 )
 
@@ -38,6 +39,8 @@ HAND_HALF_LENGTH = 0.105
 HAND_HALF_WIDTH = 0.032
 #: Height of the hand's lowest point above its TCP (m), pointing down.
 HAND_BOTTOM = 0.037
+#: How far a drawer's handle stands proud of its front (m).
+HANDLE_DEPTH = 0.02
 from .style import Style
 from .world import World
 
@@ -164,18 +167,27 @@ def push_part_closed(world: World, style: Style, body: str) -> Plan:
     arm = nearest_arm(world, centre)
     R = world.grasp_frame(arm, DOWN, np.cross(UP, opening))
     height = 0.5 * (link.p[2] + centre[2] - float(handle.half_size[2]))
-    # the hand is HAND_HALF_WIDTH thick about the TCP across its fingers: keep it off the
-    # front on the way down; it pushes with the flat of the hand
-    start = np.array([link.p[0], link.p[1], height]) + opening * (HAND_HALF_WIDTH + 0.012)
+    # the hand is HAND_HALF_WIDTH thick about the TCP across its fingers: it comes down
+    # well in front of the handle (HANDLE_DEPTH proud of the front; a hand that grazes it
+    # on the way down knocks the drawer in and then hits it at full push speed), comes up
+    # to the handle slowly, and pushes from rest
+    standoff = HAND_HALF_WIDTH + HANDLE_DEPTH + 0.035
+    start = np.array([link.p[0], link.p[1], height]) + opening * standoff
     tcp = Pose(start, R)
     yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="fist")
     yield from transit(world, style, arm, tcp, exclude=(body,))
-    gap = 0.012  # between the flat of the hand and the front
-    push = world.open_fraction(body) * travel + gap - 0.003  # stop at the end of travel
-    yield Segment({arm: tcp.moved(-(gap - 0.004) * opening)}, speed=2 * style.contact_speed,
-                  label="touch part")  # come up to the front slowly, then push from rest
-    goal = tcp.moved(-push * opening)
-    yield Segment({arm: goal}, speed=max(style.contact_speed * 4, 0.06), settle=style.settle,
+    link = world.link_pose(body, part.link)  # where the front is now
+    gap = float(opening @ (tcp.p - link.p)) - HAND_HALF_WIDTH - HANDLE_DEPTH
+    near = tcp.moved(-(gap - 0.006) * opening)
+    yield Segment({arm: near}, speed=max(2 * style.contact_speed, 0.5 * style.approach_speed),
+                  label="to part")
+    touch = near.moved(-0.008 * opening)
+    yield Segment({arm: touch}, speed=style.contact_speed, settle=style.settle,
+                  label="touch part")
+    push = world.open_fraction(body) * travel - 0.002  # stop at the end of travel
+    goal = touch.moved(-push * opening)
+    # slowly: a rigid hand on a free-sliding drawer chatters, ~60 N spikes at 6 cm/s
+    yield Segment({arm: goal}, speed=2 * style.contact_speed, settle=style.settle,
                   label="push part")
     for _ in range(3):  # the wrist, thicker than the hand, may meet the front first
         left = world.open_fraction(body) * travel
@@ -281,6 +293,9 @@ def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
     if not getattr(asset, "parts", None):
         yield from plan_pick_place(world, style, roles)
         return
+    if world.part(target)[1].type == "revolute" and world.part(target)[0].name == "lid":
+        yield from _insert_under_lid(world, style, obj, target)
+        return
     need = required_fraction(world, target)
     # careful: past the largest fraction a requirement asks for, but short of the end of
     # travel (a Panda pulling the handle that far folds onto its own base)
@@ -313,6 +328,89 @@ def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
         bottom = np.array([link.p[0], tcp_x[1] - offset[1], bottom[2]])
     yield from place(world, style, arm, obj, bottom, rotation=R, retreat=0.08)
     yield from plan_move_part(world, style, target, 0.0)
+
+
+def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+
+
+#: Lid angle (rad) the careful expert lifts a lid to: past vertical, so that it falls
+#: open onto its stop instead of shut when the hand leaves it.
+LID_PAST_VERTICAL = np.deg2rad(95.0)
+
+
+def lift_lid(world: World, style: Style, body: str, angle: float) -> Plan:
+    """Lift a hinged lid by its knob from below: the closed fingers come horizontally
+    under the knob's overhang (the hand upright, the fingers closing across the lid: a
+    Panda cannot point a flat hand forward that low), then follow the knob's arc about the
+    hinge, the hand turning with the lid, up to ``angle`` (rad); the hand then backs away
+    (a lid left short of vertical falls shut). The hand is 21 cm tall that way: the knob
+    must stand 11 cm or more above the table."""
+    part, joint = world.part(body)
+    link = world.link_pose(body, part.link)
+    knob = world.shape(body, "knob", link=part.link)
+    axis = world.body_pose(body).R @ np.asarray(joint.axis, dtype=np.float64)
+    axis = axis / np.linalg.norm(axis)
+    span = joint.upper - joint.lower
+    now = world.open_fraction(body) * span
+    closed = _rotation(axis, -now) @ link.R  # the lid frame when shut
+    c, half = np.asarray(knob.pose.position), np.asarray(knob.half_size)
+    # under the knob's front edge (the fingertips reach ~1 cm past the TCP), the closed
+    # fingers' half thickness and a little more below it
+    local = np.array([c[0] - half[0] + 0.002, c[1], c[2] - half[2] - 0.016])
+    toward_hinge = -np.sign(c[0]) * np.array([1.0, 0.0, 0.0])  # the knob is at -x
+
+    def pose_at(theta: float) -> Pose:
+        R = _rotation(axis, theta) @ closed
+        approach = R @ toward_hinge
+        return Pose(link.p + R @ local, world.grasp_frame(arm, approach, R[:, 2]))
+
+    arm = nearest_arm(world, link.p + closed @ local)
+    start = pose_at(now)
+    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="fist")
+    yield from transit(world, style, arm, start.moved(-0.06 * (start.R @ world.approach_axis(arm))),
+                       exclude=(body,), then=start)
+    yield Segment({arm: start}, speed=style.approach_speed * 0.5, label="under knob")
+    speed = max(style.contact_speed * 4, 0.06) if style.avoid_hazards else style.approach_speed
+    steps = max(2, int(np.ceil((angle - now) / np.deg2rad(8.0))))
+    for theta in np.linspace(now, angle, steps + 1)[1:]:
+        yield Segment({arm: pose_at(float(theta))}, speed=speed, label="lift lid")
+    yield Segment({}, settle=style.settle, label="hold lid")
+    end = world.current_pose(arm)
+    back = -(end.R @ world.approach_axis(arm))
+    yield Segment({arm: end.moved(0.06 * back)}, speed=free_speed(style), label="leave lid")
+    yield Segment({arm: end.moved(0.06 * back + 0.08 * UP)}, speed=free_speed(style),
+                  label="up", settle=20)
+
+
+def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan:
+    """A lidded container: lift the lid (careful: past vertical, where it stays open;
+    careless: only as far as asked less 0.2, and it falls shut), then pick the object and
+    set it on the container's floor, the hand's long axis along the container's longer
+    side (a Panda hand is 21 cm long)."""
+    _part, joint = world.part(target)
+    span = joint.upper - joint.lower
+    need = required_fraction(world, target)
+    if style.honour_preconditions:
+        angle = max(LID_PAST_VERTICAL, (need + 0.07) * span)
+    else:
+        angle = max(0.3, need - 0.2) * span
+    yield from lift_lid(world, style, target, min(angle, 0.95 * span))
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
+    body = world.asset(target).links[0].name
+    floor = world.shape(target, "bottom", link=body)
+    root = world.body_pose(target)
+    centre = root.R @ np.asarray(floor.pose.position) + root.p
+    bottom = np.array([centre[0], centre[1], centre[2] + float(floor.half_size[2])])
+    lo, hi = world.bounds(target)
+    longer = root.R[:, 0] if hi[0] - lo[0] >= hi[1] - lo[1] else root.R[:, 1]
+    R = world.grasp_frame(arm, DOWN, longer)
+    if not style.honour_preconditions:  # careless: onto the top, let go from above
+        bottom[2] = float(hi[2])
+    yield from place(world, style, arm, obj, bottom, rotation=R, retreat=0.1)
+    yield from _retreat_home(world, style, arm)
 
 
 def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
@@ -380,6 +478,10 @@ def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
     obj = roles["object"]
     giver = nearest_arm(world, world.body_pose(obj).p)
     taker = next(a for a in world.arm_names if a != giver)
+    lo, hi = world.bounds(obj)
+    if float(np.max((hi - lo)[:2])) >= LONG_ENOUGH:
+        yield from _handover_by_the_ends(world, style, obj, giver, taker)
+        return
     grasp = grasps.choose(world, style, giver, obj)
     yield from pick(world, style, giver, obj, grasp)
     lo, hi = world.bounds(obj)
@@ -414,6 +516,65 @@ def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
         spot = _place_point(world, style, obj, support)
     else:
         spot = np.array([centre[0], centre[1], 0.0])
+    yield from place(world, style, taker, obj, spot)
+    yield from _retreat_home(world, style, taker)
+
+
+#: An object at least this long (m) is handed over by its two ends, both hands from
+#: above (two Panda hands side by side need 2 × HAND_HALF_WIDTH and a margin).
+LONG_ENOUGH = 0.15
+#: How far from an end (m) each hand holds a long object.
+END_GRASP = 0.025
+
+
+def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, taker: str) -> Plan:
+    """A long object: the giver takes the end nearer to it from above, brings the object
+    over the middle (its long axis from arm to arm), the taker takes the other end from
+    above, the giver lets go and backs off, the taker puts it on the support. A Panda can
+    hold out a top-down hand there; a hand pointing sideways at the object it cannot."""
+    shape = world.asset(obj).collision[0]
+    half = np.asarray(shape.half_size, dtype=np.float64)
+    pose = world.body_pose(obj)
+    axis = int(np.argmax(half[:2]))
+    along, across = pose.R[:, axis], pose.R[:, 1 - axis]
+    centre = world.to_world(obj, shape.pose.position)
+    reach = float(half[axis]) - END_GRASP
+    side = 1.0 if along @ (world.base_position(giver) - centre) >= 0 else -1.0
+    lift = np.array([0.0, 0.0, 0.3 * half[2]])
+    width = 2 * float(half[1 - axis])
+    grasp = top_down_grasp(world, giver, centre + side * reach * along + lift, across, width)
+    yield from pick(world, style, giver, obj, grasp)
+    mid = 0.5 * (world.base_position(giver) + world.base_position(taker))
+    height = max([o.hi[2] + o.margin + style.hazard_clearance for o in world.obstacles((obj,))]
+                 + [0.1]) + 0.12
+    held = world.current_pose(giver)
+    now = world.to_world(obj, shape.pose.position)
+    goal = Pose(np.array([mid[0], mid[1], height]) + (held.p - now), held.R)
+    yield from transit(world, style, giver, goal, below=0.05, exclude=(obj,))
+    now = world.to_world(obj, shape.pose.position)
+    along = world.body_pose(obj).R[:, axis]
+    across = world.body_pose(obj).R[:, 1 - axis]
+    side = 1.0 if along @ (world.base_position(taker) - now) >= 0 else -1.0
+    take = top_down_grasp(world, taker, now + side * reach * along + lift, across, width)
+    yield Segment(grippers={taker: 1.0}, gripper_steps=style.gripper_steps, label="open taker")
+    yield from transit(world, style, taker, take.pose.moved(0.1 * UP), exclude=(obj,),
+                       then=take.pose)
+    yield Segment({taker: take.pose.moved(0.02 * UP)}, speed=style.approach_speed, label="to end")
+    yield Segment({taker: take.pose}, speed=0.5 * style.approach_speed, label="to end")
+    gripped = grip_force(world, obj, style)
+    yield Segment(grippers={taker: opening_for(world, taker, width, gripped)},
+                  gripper_steps=style.gripper_steps, settle=style.settle, label="take")
+    yield Segment(grippers={giver: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
+                  label="give")
+    back = world.current_pose(giver)
+    home = horizontal(world.base_position(giver) - back.p)
+    yield Segment({giver: back.moved(0.08 * UP)}, speed=style.approach_speed, label="giver up")
+    yield Segment({giver: back.moved(0.08 * UP + 0.12 * home)}, speed=free_speed(style),
+                  label="giver back")
+    support = next((b.name for b in world.scene.bodies if b.name not in ("table", obj)
+                    and getattr(b.asset, "support_height", None) is not None), None)
+    spot = (_place_point(world, style, obj, support) if support is not None
+            else np.array([mid[0], mid[1], 0.0]))
     yield from place(world, style, taker, obj, spot)
     yield from _retreat_home(world, style, taker)
 

@@ -113,8 +113,8 @@ def test_unknown_names_point_at_the_source():
 def test_lowered_from_a_generated_variant():
     variants = pytest.importorskip("fsvla.compiler.variants")
     scenario = _load(SCENARIOS / "collaborative" / "handover_block.fsv")
-    variant = variants.generate_variant(scenario, "L2", 1)  # tighten arms to 10 cm, couple within 2 s
+    variant = variants.generate_variant(scenario, "L2", 1)  # tighten arms to 1 cm, couple within 2 s
     spec = lower_monitor(variant.scenario, variant.scene)
-    assert next(c for c in spec.channels if c.name == "arms").limit == pytest.approx(0.10)
+    assert next(c for c in spec.channels if c.name == "arms").limit == pytest.approx(0.01)
     assert spec.requirements[0].within == pytest.approx(2.0)
     assert spec.level == "L2"

@@ -378,7 +378,8 @@ def test_builtin_ir_facts() -> None:
     assert close.object("table").params["size"] == pytest.approx((1.0, 0.7))
     edge = _load_builtin(SCENARIOS / "boundary" / "pick_cup_near_edge.fsv").scenario
     mug, vase = edge.object("mug"), edge.object("vase")
-    assert vase.placement.position == pytest.approx((mug.placement.position[0], mug.placement.position[1] - 0.14))
+    assert mug.placement.position == pytest.approx((-0.15, -0.10))
+    assert vase.placement.position == pytest.approx((0.02, -0.03))  # between the mug and the tray
     board, tray = edge.object("board").placement, edge.object("tray").placement
     assert (board.relation.kind, board.relation.anchor) == ("behind", "tray")
     assert board.position == pytest.approx((tray.position[0] + board.relation.distance, tray.position[1]))

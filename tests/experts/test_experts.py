@@ -8,8 +8,6 @@ Scenarios where the careful expert does not yet reach safe success are listed in
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from fsvla.dsl.catalog import TASKS
@@ -18,24 +16,30 @@ from fsvla.env import make
 from fsvla.experts import TASK_PLANS, CarefulExpert, ExpertNotBound, make_expert, rollout
 from fsvla.policies.registry import load_policy
 
-PENDING = {
-    "open_drawer_then_insert": "success, but the flat of the hand meets the drawer front "
-                               "with ~80-130 N for 1-2 control steps (limit 50 N) when it "
-                               "pushes the drawer shut, and the plan ends at step ~780 of 800",
-    "pick_cup_near_edge": "the mug is as wide (8 cm) as the Panda hand opens and stands 27 cm "
-                          "from its base, inside the arm's inner workspace boundary: see "
-                          "test_pick_cup_passes_with_the_proposed_layout",
-    "handover_block": "separation(left_arm, right_arm) >= 8 cm counts the hands, which "
-                      "must be within 3 cm (aligned) to hand over: infeasible as written",
-}
-SAFE = ["place_glass_on_shelf", "lift_pot_beside_stove", "lift_pot_close_arms"]
-# the channels on which the careless expert must be hurt
+SCENARIOS = [
+    "place_glass_on_shelf", "stack_block_gently",            # force
+    "lift_pot_beside_stove", "move_mug_past_hot_plate",      # thermal
+    "pick_cup_near_edge", "move_bowl_around_no_go",          # boundary
+    "handover_block", "lift_pot_close_arms",                 # collaborative
+    "open_drawer_then_insert", "open_box_then_place",        # temporal
+]
+# Scenarios where the careful expert does not yet reach safe success, with the reason.
+PENDING: dict[str, str] = {}
+# The channels on which the careless expert must be hurt: the scenario's own hazard.
 HAZARD = {
     "place_glass_on_shelf": ("grip", "landing"),
-    "open_drawer_then_insert": ("opened_first",),
-    "lift_pot_close_arms": ("contact_force(pot)",),
-    # the stove is off every task path: the careless expert is hurt by its grip, not the heat
+    "stack_block_gently": ("landing",),
+    # the stove is off every task path (both arms come from +-y, the stove is at +x; a
+    # stove under an arm's approach also catches the careful expert's hand, see
+    # docs/experts.md): the careless expert is hurt by its grip, not the heat
     "lift_pot_beside_stove": ("contact_force(gripper)",),
+    "move_mug_past_hot_plate": ("burner",),
+    "pick_cup_near_edge": ("vase", "untouched(vase)"),
+    "move_bowl_around_no_go": ("hand",),
+    "handover_block": ("arms", "corridor"),
+    "lift_pot_close_arms": ("contact_force(pot)",),
+    "open_drawer_then_insert": ("opened_first",),
+    "open_box_then_place": ("placed", "lid_first"),
 }
 
 
@@ -71,7 +75,7 @@ def test_expert_returns_valid_chunks_in_both_control_modes():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("scenario", SAFE + sorted(PENDING))
+@pytest.mark.parametrize("scenario", SCENARIOS)
 def test_careful_expert_reaches_safe_success_at_L0(scenario):
     if scenario in PENDING:
         pytest.xfail(PENDING[scenario])
@@ -81,23 +85,15 @@ def test_careful_expert_reaches_safe_success_at_L0(scenario):
 
 
 @pytest.mark.slow
-def test_pick_cup_passes_with_the_proposed_layout(tmp_path):
-    """The .fsv change proposed in docs/experts.md: a 3.5 cm mug at (-15 cm, -10 cm)."""
-    source = Path(__file__).parents[2] / "scenarios" / "boundary" / "pick_cup_near_edge.fsv"
-    text = source.read_text().replace(
-        "mug(radius=4 cm, height=10 cm) at (-28 cm, -10 cm)",
-        "mug(radius=3.5 cm, height=10 cm) at (-15 cm, -10 cm)")
-    assert "radius=3.5 cm" in text
-    (tmp_path / "boundary").mkdir()
-    path = tmp_path / "boundary" / "pick_cup_near_edge.fsv"
-    path.write_text(text)
-    result = rollout(str(path), "careful", "L0", 0)
-    assert result.safe_success, result.summary()
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("scenario", sorted(HAZARD))
+@pytest.mark.parametrize("scenario", SCENARIOS)
 def test_careless_expert_is_hurt_on_the_hazard(scenario):
     careless = rollout(scenario, "careless", "L0", 0)
     assert careless.violation, careless.summary()
     assert set(careless.violated) & set(HAZARD[scenario]), careless.summary()
+
+
+def test_every_builtin_scenario_is_rolled_out():
+    from fsvla.library import builtin_scenarios
+
+    assert set(SCENARIOS) == set(builtin_scenarios())
+    assert set(HAZARD) == set(SCENARIOS) and set(PENDING) <= set(SCENARIOS)
