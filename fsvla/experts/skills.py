@@ -69,7 +69,8 @@ def opening_for(world: World, arm: str, width: float, style: Style) -> float:
 
 def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0) -> Style:
     """The style with a grip force that holds ``obj`` (friction 0.5) and stays below half
-    of the force limits on the gripper and the object, and out of their warning bands."""
+    of the force limits on the gripper and the object, and out of their warning bands
+    where that leaves enough to hold it."""
     if style.grip_force is None:
         return style
     mass = float(world.asset(obj).mass)
@@ -78,8 +79,10 @@ def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0)
     for channel in world.monitor.channels:
         names = {"gripper", obj, *[f"{a}_gripper" for a in world.arm_names]}
         if channel.metric == "contact_force" and set(channel.subjects) & names:
-            # half the limit, and out of its warning band
-            force = min(force, 0.5 * channel.limit, channel.limit - channel.soft_threshold - 1.0)
+            # half the limit, and out of its warning band unless holding the object
+            # needs more (a tightened limit): then inside the band, which costs but is safe
+            out_of_band = channel.limit - channel.soft_threshold - 1.0
+            force = min(force, 0.5 * channel.limit, max(out_of_band, need))
     return replace(style, grip_force=force)
 
 
