@@ -70,3 +70,20 @@ def physics_material(
         roughness=substance.roughness,
         metallic=substance.metallic,
     )
+
+
+#: RGB of the colours a scenario can give a body by name (``color=blue``; the catalog's
+#: ``COLOR_NAMES``): saturated enough to tell apart under the V1 lighting changes.
+NAMED_COLORS: dict[str, tuple[float, float, float]] = {
+    "red": (0.80, 0.15, 0.13),
+    "green": (0.20, 0.62, 0.25),
+    "blue": (0.15, 0.32, 0.80),
+    "yellow": (0.92, 0.80, 0.15),
+    "orange": (0.95, 0.50, 0.10),
+    "purple": (0.52, 0.25, 0.68),
+    "pink": (0.93, 0.55, 0.70),
+    "brown": (0.45, 0.30, 0.18),
+    "white": (0.93, 0.93, 0.92),
+    "grey": (0.50, 0.50, 0.52),
+    "black": (0.08, 0.08, 0.09),
+}

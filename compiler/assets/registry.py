@@ -15,6 +15,7 @@ from fsvla.dsl.catalog import ASSETS, ZONES, AssetClass, AssetKind, Param, defau
 
 from .articulated import ARTICULATED_BUILDERS
 from .files import load_mesh_asset, load_urdf_asset
+from .materials import NAMED_COLORS
 from .model import ArticulatedAsset, ParamValue, RigidAsset, ZoneAsset
 from .rigid import RIGID_BUILDERS
 from .zones import build_zone_marker as _build_zone_marker
@@ -34,14 +35,30 @@ def build_asset(
     entry = _lookup(kind, ASSETS, other=ZONES, other_hint="a zone kind; use build_zone_marker")
     merged = merge_params(entry, params or {})
     if entry.asset_class is AssetClass.RIGID:
-        return RIGID_BUILDERS[kind](merged)
+        return recolored(RIGID_BUILDERS[kind](merged), merged.get("color"))
     if entry.asset_class is AssetClass.ARTICULATED:
         return ARTICULATED_BUILDERS[kind](merged)
     if kind == "mesh":
-        return load_mesh_asset(merged, base_dir=base_dir, allowed_roots=allowed_roots)
+        mesh = load_mesh_asset(merged, base_dir=base_dir, allowed_roots=allowed_roots)
+        return recolored(mesh, merged.get("color"))
     if kind == "urdf":
         return load_urdf_asset(merged, base_dir=base_dir, allowed_roots=allowed_roots)
     raise ValueError(f"asset kind {kind!r} (class {entry.asset_class.value}) has no builder")
+
+
+def recolored(asset: RigidAsset, color: ParamValue | None) -> RigidAsset:
+    """``asset`` painted the named colour (its material and every visual part; each
+    keeps its own transparency, roughness and glow), or unchanged for None."""
+    if color is None:
+        return asset
+    r, g, b = NAMED_COLORS[str(color)]
+    material = asset.material.model_copy(
+        update={"base_color": (r, g, b, asset.material.base_color[3])})
+    visuals = [part if part.appearance is None else part.model_copy(update={
+        "appearance": part.appearance.model_copy(
+            update={"base_color": (r, g, b, part.appearance.base_color[3])})})
+        for part in asset.visuals]
+    return asset.model_copy(update={"material": material, "visuals": visuals})
 
 
 def build_zone_marker(

@@ -22,10 +22,11 @@ from ..assets.registry import merge_params
 from ..placement import Rect, rotate_xy, support_order
 from ..scene import WORLD, surface_height
 
-#: Distractors for ``clutter``: catalogue kinds with everyday sizes (SI).
+#: Distractors for ``clutter``: catalogue kinds with everyday sizes (SI). The blocks are
+#: not the default red of a block, so that a distractor is never a copy of "the red block".
 CLUTTER_PALETTE: tuple[tuple[str, dict[str, ParamValue]], ...] = (
-    ("block", {"size": (0.05, 0.05, 0.05)}),
-    ("block", {"size": (0.08, 0.04, 0.04)}),
+    ("block", {"size": (0.05, 0.05, 0.05), "color": "yellow"}),
+    ("block", {"size": (0.08, 0.04, 0.04), "color": "purple"}),
     ("bottle", {"radius": 0.03, "height": 0.18}),
     ("bowl", {"radius": 0.06, "height": 0.05}),
     ("mug", {"radius": 0.035, "height": 0.09}),

@@ -172,6 +172,13 @@ SEMANTIC_CASES = [
     ("FSV505-setting-too-early", add("vision", "  V1: patch(pot)"),
      "FSV505", 10, 9, "`patch` belongs to V4 and above",
      "move it under `V4:`; levels are cumulative, so it applies from there on"),
+    ("FSV207-colour-misspelt", add("object b: block(color=bleu) at (20 cm, 0)"),
+     "FSV207", 9, 25, "`color` of `block` must be one of red, green, blue, yellow, orange, purple, "
+     "pink, brown, white, grey, black", "did you mean `blue`?"),
+    ("FSV207-colour-as-rgb", add("object b: block(color=(0.1, 0.2, 0.3)) at (20 cm, 0)"),
+     "FSV207", 9, 25, "`color` of `block` must be one of red, green, blue, yellow, orange, purple, "
+     "pink, brown, white, grey, black",
+     "write one of: red, green, blue, yellow, orange, purple, pink, brown, white, grey, black"),
     ("FSV403-asset-outside-roots", add('object m: mesh(path="../../etc/passwd")'),
      "FSV403", 9, 23, "`../../etc/passwd` is outside the allowed folders", None),
     ("FSV404-asset-missing", add('object m: mesh(path="models/nope.obj")'),

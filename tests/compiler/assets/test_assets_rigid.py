@@ -189,3 +189,29 @@ def test_tray_rims_are_named_from_the_robot():
     rims = {s.name: s.pose.position for s in tray.collision if s.name.startswith("rim_")}
     assert rims["rim_front"][0] < 0.0 < rims["rim_back"][0]
     assert rims["rim_right"][1] < 0.0 < rims["rim_left"][1]
+
+
+def test_named_colour_paints_material_and_visuals_and_keeps_transparency():
+    from fsvla.compiler.assets.materials import NAMED_COLORS
+    from fsvla.dsl.catalog import COLOR_NAMES
+
+    assert set(NAMED_COLORS) == set(COLOR_NAMES)
+    blue = build_asset("block", {"color": "blue"})
+    assert blue.material.base_color == (*NAMED_COLORS["blue"], 1.0)
+    assert build_asset("block").material.base_color != blue.material.base_color
+    glass = build_asset("glass", {"color": "green"})
+    assert glass.material.base_color[:3] == NAMED_COLORS["green"]
+    assert glass.material.base_color[3] == build_asset("glass").material.base_color[3] < 1.0
+    for part in build_asset("mug", {"color": "yellow"}).visuals:
+        assert part.appearance is None or part.appearance.base_color[:3] == NAMED_COLORS["yellow"]
+    # physics is untouched by a colour
+    assert blue.mass == build_asset("block").mass
+    with pytest.raises(ValueError, match="must be one of"):
+        build_asset("block", {"color": "navy"})
+
+
+def test_every_movable_rigid_kind_takes_a_colour():
+    from fsvla.dsl.catalog import ASSETS
+
+    for kind in set(KINDS) - STATIC:
+        assert ASSETS[kind].param("color") is not None, kind
