@@ -12,7 +12,7 @@ segments between them are collision-free; see ``docs/experts.md``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,6 +24,13 @@ from fsvla.embodiments.frames import matrix_to_quat, quat_to_matrix
 MAX_JOINT_STEP = 0.12
 #: How far inside its joint limits (rad or m) a free-space move's goal configuration stays.
 LIMIT_MARGIN = 0.15
+#: How far inside its joint limits (rad or m) a line that must be followed stays, and the
+#: step (m) at which it is checked (:meth:`ArmDriver.tracks`).
+TRACK_MARGIN = 0.05
+TRACK_STEP = 0.01
+#: Clearance (m) beyond a hazard's hard limit the careful arm's links should keep: the
+#: links are measured at their hulls' vertices, up to ~1 cm farther than their faces.
+CLEAR_NEEDED = 0.03
 
 
 @dataclass(frozen=True)
@@ -61,6 +68,8 @@ class Segment:
     joint_space: bool = False  # free-space move: interpolate joints to the IK of the target
     branch_of: dict[str, Pose] = field(default_factory=dict)  # joint_space: end on the IK
     # branch that also reaches these poses (the grasp below a hover point)
+    joints: dict[str, NDArray[np.float64]] = field(default_factory=dict)  # joint_space: the
+    # end joints the plan chose (a branch that follows a path after it), instead of IK
 
 
 def slerp(R0: NDArray[np.float64], R1: NDArray[np.float64], s: float) -> NDArray[np.float64]:
@@ -94,6 +103,11 @@ class ArmDriver:
         self.q = np.asarray(qpos, dtype=np.float64)
         self.gripper = float(gripper)
         self.ik_misses = 0
+        #: joints -> the arm's distance to the hazards watching it, less their hard limits
+        #: (m; the careful expert's :class:`~fsvla.experts.clearance.ArmClearance`), and
+        #: how much a free-space move's goal should keep along the line that follows it
+        self.clearance: Callable[[NDArray[np.float64]], float] | None = None
+        self.clear_needed = CLEAR_NEEDED
 
     def solve_anywhere(self, pose: Pose, branch_of: Pose | None = None) -> NDArray[np.float64]:
         """Joints for ``pose`` on any IK branch (the seeded one when it is within the
@@ -103,8 +117,29 @@ class ArmDriver:
             q_branch = self.solve_anywhere(branch_of)
             result = self.kin.inverse(tuple(pose.p), pose.quat, seed=q_branch, restarts=0,
                                       max_iterations=300)
+            first = np.asarray(result.qpos, dtype=np.float64)
+            clear = self.line_clearance(first, pose, branch_of) \
+                if self._comfortable(result) else None
+            if clear is not None and clear >= self.clear_needed:
+                return first
+            # a branch from which the straight line on to ``branch_of`` can be followed
+            # (one that merely reaches both ends may lose the line in between: a hand
+            # pulling a drawer toward the base folds the wrist onto its joint-5 limit), and
+            # with an arm-clearance check, the one whose links stay farthest from hazards
+            extra = [first] if self._comfortable(result) else []
+            if self.clearance is not None:
+                turned = self.kin.inverse(tuple(pose.p), pose.quat, seed=self.swivel(
+                    branch_of, q_branch), restarts=0, max_iterations=300)
+                if self._comfortable(turned):
+                    extra.append(np.asarray(turned.qpos, dtype=np.float64))
+            other = self.branch_that_tracks(pose, branch_of, extra)
+            if other is not None and clear is not None:  # another branch only if clearer
+                better = self.line_clearance(other, pose, branch_of)
+                return other if better is not None and better > clear + 0.005 else first
+            if other is not None:
+                return other
             if self._comfortable(result):
-                return np.asarray(result.qpos, dtype=np.float64)
+                return first
         result = self.kin.inverse(tuple(pose.p), pose.quat, seed=self.q, restarts=0,
                                   max_iterations=300)
         if not self._comfortable(result):
@@ -114,11 +149,138 @@ class ArmDriver:
                 if self._comfortable(r) and (
                         best is None or _jump(r, self.q) < _jump(best, self.q)):
                     best = r
+            # none near home: seeds spread over the whole joint range before giving up (a
+            # top-down grasp close to the base has comfortable answers far from home)
+            for seed in (self._wide_seeds() if best is None else ()):
+                r = self.kin.inverse(tuple(pose.p), pose.quat, seed=seed, restarts=0)
+                if self._comfortable(r) and (
+                        best is None or _jump(r, self.q) < _jump(best, self.q)):
+                    best = r
             if best is None:
                 self.ik_misses += 1
             else:
                 result = best
         return np.clip(result.qpos, self.kin.limits[:, 0], self.kin.limits[:, 1])
+
+    def tracks(self, q: NDArray[np.float64], start: Pose, end: Pose) -> bool:
+        """Whether the straight line from ``start`` (at joints ``q``) to ``end`` is solved
+        at every step on ``q``'s branch, at least TRACK_MARGIN inside the joint limits."""
+        return self.line_clearance(q, start, end, check=False) is not None
+
+    def line_clearance(self, q: NDArray[np.float64], start: Pose, end: Pose,
+                       check: bool = True) -> float | None:
+        """None unless the straight line from ``start`` (at joints ``q``) to ``end`` is
+        solved at every step on ``q``'s branch, at least TRACK_MARGIN inside the joint
+        limits; else the arm's smallest :attr:`clearance` along it (inf without one)."""
+        import copy
+
+        trial = copy.copy(self)
+        trial.q, trial.pose, trial.ik_misses = np.asarray(q, dtype=np.float64), start, 0
+        lo, hi = self.kin.limits[:, 0] + TRACK_MARGIN, self.kin.limits[:, 1] - TRACK_MARGIN
+        n = max(1, int(np.ceil(float(np.linalg.norm(end.p - start.p)) / TRACK_STEP)),
+                int(np.ceil(rotation_angle(start.R, end.R) / (10 * TRACK_STEP))))
+        measure = self.clearance if check else None
+        clear = float("inf") if measure is None else measure(trial.q)
+        for i in range(1, n + 1):
+            s = i / n
+            q_i = trial.solve(Pose(start.p + s * (end.p - start.p), slerp(start.R, end.R, s)))
+            if trial.ik_misses or np.any(q_i < lo) or np.any(q_i > hi):
+                return None
+            trial.q = q_i
+            if measure is not None:
+                clear = min(clear, measure(q_i))
+        return clear
+
+    def branch_that_tracks(self, pose: Pose, branch_of: Pose,
+                           extra: Sequence[NDArray[np.float64]] = ()) -> NDArray[np.float64] | None:
+        """Comfortable joints for ``pose`` from which the line to ``branch_of`` is followed
+        (:meth:`line_clearance`): the nearest the present joints of those in ``extra`` whose
+        arm stays clear of the hazards by ``clear_needed``; else, among them and the answers
+        from several seeds, the clearest, then the nearest; None if none is followed."""
+        best: NDArray[np.float64] | None = None
+        best_key: tuple[float, float] | None = None
+
+        def consider(q: NDArray[np.float64]) -> None:
+            nonlocal best, best_key
+            jump = float(np.max(np.abs(q - self.q)))
+            if best_key is not None and best_key[0] >= self.clear_needed and jump >= -best_key[1]:
+                return  # one clear enough and nearer is already found
+            clear = self.line_clearance(q, pose, branch_of)
+            if clear is None:
+                return
+            key = (round(min(clear, self.clear_needed), 3), -jump)
+            if best_key is None or key > best_key:
+                best, best_key = q, key
+
+        for q in extra:  # on the branch the plan was on: kept when clear enough
+            consider(q)
+        if best_key is not None and best_key[0] >= self.clear_needed:
+            return best
+        for seed in (self.q, self.kin.arm.spec.home, *self._seeds()):
+            rb = self.kin.inverse(tuple(branch_of.p), branch_of.quat, seed=seed, restarts=0,
+                                  max_iterations=300)
+            if not self._comfortable(rb):
+                continue
+            r = self.kin.inverse(tuple(pose.p), pose.quat, seed=rb.qpos, restarts=0,
+                                 max_iterations=300)
+            if self._comfortable(r):
+                consider(np.asarray(r.qpos, dtype=np.float64))
+        return best
+
+    def swivel(self, pose: Pose, q: NDArray[np.float64], steps: int = 40,
+               step: float = 0.08) -> NDArray[np.float64]:
+        """Joints for ``pose`` turned from ``q`` about the arm's self-motion (the elbow's
+        swivel of a 7-joint arm, the hand held still) to where :attr:`clearance` first
+        reaches ``clear_needed`` and a little more, or is largest; ``q`` without a
+        clearance measure."""
+        if self.clearance is None:
+            return q
+        # a little more than needed: the line that follows drifts back part of the way
+        enough = self.clear_needed + 0.015
+        best, best_clear = np.asarray(q, dtype=np.float64), self.clearance(q)
+        if best_clear >= enough:
+            return best
+        lo, hi = self.kin.limits[:, 0] + LIMIT_MARGIN, self.kin.limits[:, 1] - LIMIT_MARGIN
+        for sign in (1.0, -1.0):
+            cur, prev = np.asarray(q, dtype=np.float64), None
+            for _ in range(steps):
+                n = self._null(cur)
+                if n is None:
+                    break
+                direction = sign * n if prev is None else (n if n @ prev >= 0 else -n)
+                prev = direction
+                r = self.kin.inverse(tuple(pose.p), pose.quat, seed=cur + step * direction,
+                                     restarts=0, max_iterations=100)
+                q_next = np.asarray(r.qpos, dtype=np.float64)
+                if (not r.ok(position_tol=2e-3, rotation_tol=2e-2) or np.any(q_next < lo)
+                        or np.any(q_next > hi)):
+                    break
+                cur = q_next
+                clear = self.clearance(cur)
+                if clear > best_clear + 1e-4:
+                    best, best_clear = cur, clear
+                    if clear >= enough:
+                        break
+        return best
+
+    def _null(self, q: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """A unit joint direction that moves the TCP least (the Jacobian's null space)."""
+        if len(q) < 7:
+            return None
+        base = self.kin.tcp_pose(q)
+        p0, R0 = np.asarray(base.p), quat_to_matrix(base.q)
+        J = np.zeros((6, len(q)))
+        h = 1e-4
+        for j in range(len(q)):
+            dq = np.array(q, dtype=np.float64)
+            dq[j] += h
+            moved = self.kin.tcp_pose(dq)
+            rel = R0.T @ quat_to_matrix(moved.q)
+            J[:3, j] = (np.asarray(moved.p) - p0) / h
+            J[3:, j] = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0],
+                                 rel[1, 0] - rel[0, 1]]) / (2 * h)
+        _, _, vt = np.linalg.svd(J)
+        return vt[-1] / np.linalg.norm(vt[-1])
 
     def _comfortable(self, result) -> bool:
         """An exact answer at least LIMIT_MARGIN inside every joint limit (a Panda whose
@@ -132,6 +294,11 @@ class ArmDriver:
         lo, hi = self.kin.limits[:, 0] + LIMIT_MARGIN, self.kin.limits[:, 1] - LIMIT_MARGIN
         home = np.asarray(self.kin.arm.spec.home, dtype=np.float64)
         return [np.clip(home + rng.normal(0.0, 0.6, home.shape), lo, hi) for _ in range(16)]
+
+    def _wide_seeds(self) -> list[NDArray[np.float64]]:
+        rng = np.random.default_rng(1)
+        lo, hi = self.kin.limits[:, 0] + LIMIT_MARGIN, self.kin.limits[:, 1] - LIMIT_MARGIN
+        return [rng.uniform(lo, hi) for _ in range(48)]
 
     def solve(self, pose: Pose) -> NDArray[np.float64]:
         """Joints for ``pose``, seeded by the last command; the closest answer if none is
@@ -179,13 +346,14 @@ def expand(segment: Segment, drivers: Mapping[str, ArmDriver], dt: float,
         turn = rotation_angle(d.pose.R, target.R)
         n = max(n, int(np.ceil(dist / max(segment.speed * dt, 1e-6))),
                 int(np.ceil(turn / max(angular_speed * dt, 1e-6))))
-    if segment.targets and segment.joint_space and _straight_line_ok(segment, drivers, dt,
-                                                                     angular_speed):
+    if segment.targets and segment.joint_space and not segment.joints and _straight_line_ok(
+            segment, drivers, dt, angular_speed):
         segment = Segment(segment.targets, segment.speed, segment.grippers,
                           segment.gripper_steps, segment.settle, segment.label)
     if segment.targets and segment.joint_space:
         q0 = {name: drivers[name].q.copy() for name in segment.targets}
-        q1 = {name: drivers[name].solve_anywhere(t, segment.branch_of.get(name))
+        q1 = {name: np.asarray(segment.joints[name], dtype=np.float64) if name in segment.joints
+              else drivers[name].solve_anywhere(t, segment.branch_of.get(name))
               for name, t in segment.targets.items()}
         joint_speed = angular_speed
         n = max(n, max(int(np.ceil(float(np.max(np.abs(q1[k] - q0[k]))) / (joint_speed * dt)))
@@ -239,12 +407,15 @@ def _straight_line_ok(segment: Segment, drivers: Mapping[str, ArmDriver], dt: fl
         if d.ik_misses or np.any(d.q < lo) or np.any(d.q > hi):
             return False
         branch = segment.branch_of.get(name)
-        if branch is not None:  # the straight line must also leave the goal reachable
-            probe = copy.copy(d)
-            probe.ik_misses = 0
-            probe.solve(branch)
-            if probe.ik_misses:
+        if branch is not None:  # the straight line on to the next pose must be followed,
+            clear = d.line_clearance(d.q, d.pose, branch)  # the arm clear of the hazards
+            if clear is None:
                 return False
+            if clear < d.clear_needed:  # unless no other branch is clearer
+                other = copy.copy(drivers[name]).solve_anywhere(segment.targets[name], branch)
+                alternative = d.line_clearance(other, segment.targets[name], branch)
+                if alternative is not None and alternative > clear + 0.005:
+                    return False
     return True
 
 

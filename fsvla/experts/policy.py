@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .clearance import ArmClearance
 from .motion import ArmDriver, Segment, Step, expand
 from .style import CAREFUL, CARELESS, STYLES, Style
 from .tasks import TASK_PLANS
@@ -75,6 +76,9 @@ class ExpertPolicy:
             self._drivers[name] = ArmDriver(name, world.kinematics(name),
                                             world.current_pose(name), arm.qpos(),
                                             arm.gripper_opening())
+            if self.style.avoid_hazards:  # its links too, not only the hand, kept clear
+                clearance = ArmClearance(world, name)
+                self._drivers[name].clearance = clearance if clearance.active else None
         self._plan = TASK_PLANS[task.name].plan(world, self.style, dict(task.roles))
         self._queue.clear()
         self._last = None

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
+from itertools import pairwise
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +26,10 @@ UP = np.array([0.0, 0.0, 1.0])
 #: faster moves shake it loose from the soft finger springs.
 CARRY_SPEED = 0.15
 LIGHT_LOAD = 0.1
+#: Effective radius (m) of a finger pad's torsional friction: a squeeze F resists a turn
+#: about the closing axis with about 2 × 0.5 × F × this (measured: an 80 g bar held 6.5 cm
+#: off its centre pivots at 12 N and stays level at 17 N).
+PAD_RADIUS = 0.004
 #: Height of the hand above its tool centre point (m), for clearing obstacles beneath it.
 HAND_RADIUS = 0.06
 
@@ -67,14 +72,18 @@ def opening_for(world: World, arm: str, width: float, style: Style) -> float:
     return float(np.clip((width - squeeze) / world.max_width(arm), 0.0, 1.0))
 
 
-def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0) -> Style:
+def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
+               lever: float = 0.0) -> Style:
     """The style with a grip force that holds ``obj`` (friction 0.5) and stays below half
     of the force limits on the gripper and the object, and out of their warning bands
-    where that leaves enough to hold it."""
+    where that leaves enough to hold it. ``lever``: how far (m) the object's centre lies
+    from the grasp, across the closing axis; the pads' torsional friction must then also
+    hold the object's weight × lever, or it pivots in the fingers (a bar held by its end)."""
     if style.grip_force is None:
         return style
     mass = float(world.asset(obj).mass)
     need = weight_factor * mass * 9.81 / (2 * 0.5)
+    need = max(need, weight_factor * mass * 9.81 * lever / (2 * 0.5 * PAD_RADIUS))
     force = max(need, style.grip_force)
     for channel in world.monitor.channels:
         names = {"gripper", obj, *[f"{a}_gripper" for a in world.arm_names]}
@@ -84,6 +93,20 @@ def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0)
             out_of_band = channel.limit - channel.soft_threshold - 1.0
             force = min(force, 0.5 * channel.limit, max(out_of_band, need))
     return replace(style, grip_force=force)
+
+
+def grasp_lever(world: World, arm: str, obj: str, tcp: Pose | None = None) -> float:
+    """Horizontal distance (m) from the grasp at ``tcp`` (default: where the hand is) to
+    the centre of ``obj``, across the fingers' closing axis: the lever its weight turns it
+    about the closing axis with."""
+    tcp = world.current_pose(arm) if tcp is None else tcp
+    lo, hi = world.bounds(obj)
+    d = 0.5 * (lo + hi) - tcp.p
+    d[2] = 0.0
+    closing = tcp.R @ world.finger_axis(arm)
+    d -= (d @ closing) * closing
+    d[2] = 0.0
+    return float(np.linalg.norm(d))
 
 
 def clear_height(world: World, style: Style, a: NDArray[np.float64], b: NDArray[np.float64],
@@ -117,11 +140,13 @@ def _segment_hits_box(a, b, lo, hi) -> bool:
 
 def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.02,
             exclude: tuple[str, ...] = (), start: Pose | None = None,
-            then: Pose | None = None) -> Plan:
+            then: Pose | None = None, follow: tuple[Pose, ...] = ()) -> Plan:
     """Straight up to a height that clears the obstacles under the path, a free-space
     (joint-space) move to above ``goal`` at that height, and straight down to it. The
     careless style's clear height ignores the hazards (zones and hazard objects), and
-    where no task object is in the way it moves in one diagonal line to above ``goal``."""
+    where no task object is in the way it moves in one diagonal line to above ``goal``.
+    ``follow``: the poses the hand goes through after ``goal`` (an arc); the free-space
+    move ends on an IK branch from which all of them are reached (:func:`branch_for_path`)."""
     a = world.current_pose(arm) if start is None else start
     clear = clear_height(world, style, a.p, goal.p, below, exclude)
     height = max(clear, goal.p[2] + 0.05)
@@ -131,9 +156,65 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
         yield Segment({arm: Pose(np.array([a.p[0], a.p[1], height]), a.R)},
                       speed=style.transit_speed, label="up")
     over = Pose(np.array([goal.p[0], goal.p[1], height]), goal.R)
+    q = branch_for_path(world, arm, (over, goal, *follow)) if follow else None
     yield Segment({arm: over}, speed=style.transit_speed, label="across", joint_space=True,
-                  branch_of={arm: then if then is not None else goal})
+                  branch_of={arm: then if then is not None else goal},
+                  joints={arm: q} if q is not None else {})
     yield Segment({arm: goal}, speed=style.transit_speed, label="down")
+
+
+#: How far (rad or m) inside its joint limits a path :func:`branch_for_path` checks stays,
+#: and the step (m, or rad / 10) at which it is checked.
+PATH_MARGIN = 0.05
+PATH_STEP = 0.01
+
+
+def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[np.float64] | None:
+    """Comfortable joints for ``path[0]`` from which the straight lines through the rest of
+    ``path`` are all solved, seeded step by step, at least PATH_MARGIN inside the joint
+    limits (an arc that a branch cannot follow drives a wrist joint onto its limit and the
+    hand off the arc); the answer nearest the arm's present joints, None if none is found.
+    Candidates: IK answers for ``path[0]``, and answers for its far end walked back along
+    the path (a pose that few seeds solve comfortably is often reached that way)."""
+    from .motion import ArmDriver, rotation_angle, slerp
+
+    kin = world.kinematics(arm)
+    now = np.asarray(world.robot.arm(arm).qpos(), dtype=np.float64)
+    probe = ArmDriver(arm, kin, path[0], now, 1.0)
+    lo, hi = kin.limits[:, 0] + PATH_MARGIN, kin.limits[:, 1] - PATH_MARGIN
+
+    def walk(q: NDArray[np.float64], poses) -> NDArray[np.float64] | None:
+        """The joints at the end of ``poses`` followed from ``q``, None if lost."""
+        trial = ArmDriver(arm, kin, poses[0], q, 1.0)
+        for a, b in pairwise(poses):
+            n = max(1, int(np.ceil(float(np.linalg.norm(b.p - a.p)) / PATH_STEP)),
+                    int(np.ceil(rotation_angle(a.R, b.R) / (10 * PATH_STEP))))
+            for i in range(1, n + 1):
+                s = i / n
+                trial.q = trial.solve(Pose(a.p + s * (b.p - a.p), slerp(a.R, b.R, s)))
+                if trial.ik_misses or np.any(trial.q < lo) or np.any(trial.q > hi):
+                    return None
+        return trial.q
+
+    def comfortable(pose: Pose, seed) -> NDArray[np.float64] | None:
+        r = kin.inverse(tuple(pose.p), pose.quat, seed=seed, restarts=0, max_iterations=300)
+        return np.asarray(r.qpos, dtype=np.float64) if probe._comfortable(r) else None
+
+    seeds = (now, kin.arm.spec.home, *probe._seeds())
+    best: NDArray[np.float64] | None = None
+    for backward in (False, True):
+        for seed in seeds:
+            q = comfortable(path[-1] if backward else path[0], seed)
+            if q is not None and backward:
+                q = walk(q, path[::-1])
+            if q is None or (best is not None and
+                             np.max(np.abs(q - now)) >= np.max(np.abs(best - now))):
+                continue
+            if walk(q, path) is not None:
+                best = q
+        if best is not None:
+            return best
+    return best
 
 
 def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
@@ -151,9 +232,13 @@ def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
 
 
 def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.float64],
-          rotation: NDArray[np.float64] | None = None, retreat: float = 0.1) -> Plan:
+          rotation: NDArray[np.float64] | None = None, retreat: float = 0.1,
+          release_gap: float | None = None) -> Plan:
     """Carry the held ``obj`` so that its origin (bottom centre) lands at ``bottom``,
-    lower it (slowly when careful), open, and back off."""
+    lower it (slowly when careful), open, and back off. ``release_gap``: open only until
+    each finger is that far (m) from the object (default: fully). Fingers that end near
+    the simulator's contact distance (2 cm: a 4 cm object in an 8 cm hand) drop in and
+    out of contact as the hand backs off, which reads as grasping it again."""
     R = world.current_pose(arm).R if rotation is None else rotation
     offset = R @ held_offset(world, arm, obj)
     goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
@@ -175,7 +260,10 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, label="lower")
     yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
                   label="touch")
-    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps * (2 if fragile else 1),
+    opening = 1.0 if release_gap is None else min(
+        1.0, world.robot.arm(arm).gripper_opening() + 2 * release_gap / world.max_width(arm))
+    yield Segment(grippers={arm: opening},
+                  gripper_steps=style.gripper_steps * (2 if fragile else 1),
                   settle=style.settle, label="release")
     back = -world.current_pose(arm).R @ world.approach_axis(arm)
     yield Segment({arm: goal.moved(retreat * back)}, speed=free_speed(style), label="retreat")
@@ -186,7 +274,7 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
     """Close the gripper on ``obj`` (``width`` across the fingers): careful with a fragile
     (force-watched) object, quickly to just short of contact and then slowly to the squeeze
     of its grip force; otherwise at the style's gripper pace."""
-    held = grip_force(world, obj, style, weight_factor)
+    held = grip_force(world, obj, style, weight_factor, grasp_lever(world, arm, obj))
     target = opening_for(world, arm, width, held)
     if style.avoid_hazards and _force_watched(world, obj):
         near = float(np.clip((width + 0.006) / world.max_width(arm), 0.0, 1.0))
@@ -225,10 +313,12 @@ __all__ = [
     "UP",
     "Grasp",
     "Plan",
+    "branch_for_path",
     "clear_height",
     "close_on",
     "free_speed",
     "gentle",
+    "grasp_lever",
     "grip_force",
     "held_offset",
     "horizontal",

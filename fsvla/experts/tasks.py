@@ -21,7 +21,9 @@ from .skills import (
     DOWN,
     UP,
     Plan,
+    branch_for_path,
     free_speed,
+    grasp_lever,
     grip_force,
     held_offset,
     horizontal,
@@ -76,9 +78,13 @@ def _predicates(cond: Condition) -> list[Predicate]:
     return []
 
 
-def _place_point(world: World, style: Style, obj: str, target: str) -> np.ndarray:
+def _place_point(world: World, style: Style, obj: str, target: str,
+                 arm: str | None = None) -> np.ndarray:
     """Where on ``target``'s top the object's bottom centre goes: the footprint's centre,
-    or (careful) the footprint point farthest from the hazards."""
+    or (careful) the footprint point farthest from the hazards; with ``arm`` (holding
+    ``obj``), careful, only among the points where the hand it holds the object with
+    stays comfortably inside the arm's joint limits (a shelf at the edge of the reach:
+    an arm stretched onto its elbow limit sags and presses the object into the shelf)."""
     asset = world.asset(target)
     pose = world.body_pose(target)
     (x0, y0), (x1, y1) = asset.footprint.min_xy, asset.footprint.max_xy
@@ -99,8 +105,21 @@ def _place_point(world: World, style: Style, obj: str, target: str) -> np.ndarra
         return min(min(d, default=1.0), 0.04) - 0.05 * float(np.linalg.norm(c - candidates[0]))
 
     best = max(candidates, key=score) if style.avoid_hazards else candidates[0]
+    if style.avoid_hazards and arm is not None:
+        best = next((c for c in sorted(candidates, key=score, reverse=True)
+                     if _reaches_place(world, arm, obj, np.array(
+                         [*(pose.R[:2, :2] @ c + pose.p[:2]), top]))), best)
     xy = pose.R[:2, :2] @ best + pose.p[:2]
     return np.array([xy[0], xy[1], top])
+
+
+def _reaches_place(world: World, arm: str, obj: str, bottom: np.ndarray) -> bool:
+    """Whether the hand holding ``obj`` as it does now can come straight down from 8 cm
+    above onto the pose that sets it down at ``bottom``, inside the arm's joint limits
+    (:func:`branch_for_path`)."""
+    tcp = world.current_pose(arm)
+    goal = Pose(bottom + tcp.R @ held_offset(world, arm, obj), tcp.R)
+    return branch_for_path(world, arm, (goal.moved(0.08 * UP), goal)) is not None
 
 
 def _retreat_home(world: World, style: Style, arm: str) -> Plan:
@@ -114,7 +133,7 @@ def plan_pick_place(world: World, style: Style, roles: dict[str, str]) -> Plan:
     arm = nearest_arm(world, world.body_pose(obj).p)
     grasp = grasps.choose(world, style, arm, obj)
     yield from pick(world, style, arm, obj, grasp)
-    yield from place(world, style, arm, obj, _place_point(world, style, obj, target))
+    yield from place(world, style, arm, obj, _place_point(world, style, obj, target, arm))
     yield from _retreat_home(world, style, arm)
 
 
@@ -211,10 +230,11 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
     part, _joint = world.part(body)
     arm = nearest_arm(world, centre)
     approach = -opening
-    R = world.grasp_frame(arm, approach, UP)
-    tcp = Pose(centre - approach * (float(handle.half_size[0]) - 0.004), R)
-    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, label="open")
     delta = (fraction - world.open_fraction(body)) * travel
+    start = centre - approach * (float(handle.half_size[0]) - 0.004)
+    R = _pull_frame(world, arm, approach, start, delta * opening)
+    tcp = Pose(start, R)
+    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, label="open")
     # the IK branch that can still reach the handle where the pull ends
     yield from transit(world, style, arm, tcp.moved(-0.1 * approach), exclude=(body,),
                        then=tcp.moved(delta * opening))
@@ -237,6 +257,24 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
     yield Segment({arm: off}, speed=free_speed(style), label="slide off")
     yield Segment({arm: off.moved(-0.03 * approach + 0.1 * UP)}, speed=free_speed(style),
                   label="up")
+
+
+def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
+                pull: np.ndarray) -> np.ndarray:
+    """The upright hand (fingers closing vertically) on a handle at ``start``, of the two
+    that differ by a half turn about the approach, from which the arm can follow the pull
+    by ``pull`` (m, world) on one IK branch; the one nearer the hand's present turn first.
+    Low and close to a Panda's base, one of them has no comfortable answer at all."""
+    from .motion import ArmDriver
+
+    R0 = world.grasp_frame(arm, approach, UP)
+    loaded = world.robot.arm(arm)
+    for R in (R0, _rotation(approach / np.linalg.norm(approach), np.pi) @ R0):
+        driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm), loaded.qpos(), 1.0)
+        tcp = Pose(start, R)
+        if driver.branch_that_tracks(tcp, tcp.moved(pull)) is not None:
+            return R
+    return R0
 
 
 def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
@@ -358,30 +396,82 @@ def lift_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     c, half = np.asarray(knob.pose.position), np.asarray(knob.half_size)
     # under the knob's front edge (the fingertips reach ~1 cm past the TCP), the closed
     # fingers' half thickness and a little more below it
-    local = np.array([c[0] - half[0] + 0.002, c[1], c[2] - half[2] - 0.016])
+    local = np.array([c[0] - half[0] - 0.002, c[1], c[2] - half[2] - 0.016])
     toward_hinge = -np.sign(c[0]) * np.array([1.0, 0.0, 0.0])  # the knob is at -x
 
-    def pose_at(theta: float) -> Pose:
+    def pose_at(theta: float, near: np.ndarray | None = None) -> Pose:
         R = _rotation(axis, theta) @ closed
         approach = R @ toward_hinge
-        return Pose(link.p + R @ local, world.grasp_frame(arm, approach, R[:, 2]))
+        return Pose(link.p + R @ local, world.grasp_frame(arm, approach, R[:, 2], near=near))
 
     arm = nearest_arm(world, link.p + closed @ local)
     start = pose_at(now)
     yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="fist")
-    yield from transit(world, style, arm, start.moved(-0.06 * (start.R @ world.approach_axis(arm))),
-                       exclude=(body,), then=start)
+    back_off = -0.06 * (start.R @ world.approach_axis(arm))
+    arc: tuple[Pose, ...] = ()
+    if style.avoid_hazards:
+        # on an IK branch that follows the whole arc (others drive a wrist joint onto its
+        # limit half way up: the hand leaves the arc and jams against the lid), the hand
+        # turned either way about its approach (a fist is symmetric), each pose of the
+        # arc the turn nearest the one before
+        flipped = start.R @ _rotation(world.approach_axis(arm), np.pi)
+        options = [_chained(pose_at, now, angle, R0) for R0 in (start.R, flipped)]
+        arc = next((a for a in options if branch_for_path(
+            world, arm, (a[0].moved(back_off), *a)) is not None), options[0])
+        start = arc[0]
+    yield from transit(world, style, arm, start.moved(back_off), exclude=(body,), then=start,
+                       follow=arc)
     yield Segment({arm: start}, speed=style.approach_speed * 0.5, label="under knob")
     speed = max(style.contact_speed * 4, 0.06) if style.avoid_hazards else style.approach_speed
-    steps = max(2, int(np.ceil((angle - now) / np.deg2rad(8.0))))
-    for theta in np.linspace(now, angle, steps + 1)[1:]:
-        yield Segment({arm: pose_at(float(theta))}, speed=speed, label="lift lid")
+    if style.avoid_hazards:
+        # one smooth arc, one control step per segment (each segment eases in and out: a
+        # chain of 8° chords stops and starts the hand under the lid, which rises off the
+        # fingers and lands back on them, 30-60 N spikes)
+        last = [start.R]
+
+        def chained_at(theta: float) -> Pose:
+            pose = pose_at(theta, last[0])
+            last[0] = pose.R
+            return pose
+
+        yield from _smooth_arc(world, style, arm, chained_at, now, angle, speed, "lift lid")
+    else:
+        steps = max(2, int(np.ceil((angle - now) / np.deg2rad(8.0))))
+        for theta in np.linspace(now, angle, steps + 1)[1:]:
+            yield Segment({arm: pose_at(float(theta))}, speed=speed, label="lift lid")
     yield Segment({}, settle=style.settle, label="hold lid")
     end = world.current_pose(arm)
     back = -(end.R @ world.approach_axis(arm))
     yield Segment({arm: end.moved(0.06 * back)}, speed=free_speed(style), label="leave lid")
     yield Segment({arm: end.moved(0.06 * back + 0.08 * UP)}, speed=free_speed(style),
                   label="up", settle=20)
+
+
+def _chained(pose_at: Callable[..., Pose], start: float, end: float, near: np.ndarray,
+             n: int = 12) -> tuple[Pose, ...]:
+    """``pose_at(theta, near)`` at ``n`` angles from ``start`` to ``end``, each turned the
+    way nearest the pose before (the first: nearest ``near``)."""
+    poses = []
+    for theta in np.linspace(start, end, n):
+        poses.append(pose_at(float(theta), near))
+        near = poses[-1].R
+    return tuple(poses)
+
+
+def _smooth_arc(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose],
+                start: float, end: float, speed: float, label: str) -> Plan:
+    """Follow ``pose_at(theta)`` from ``start`` to ``end`` without stopping: one segment per
+    control step, the parameter eased in and out over the whole arc, the peak TCP speed
+    ``speed`` and the peak turn rate within the style's angular speed."""
+    thetas = np.linspace(start, end, 50)
+    points = np.array([pose_at(float(t)).p for t in thetas])
+    length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
+    duration = 1.5 * max(length / speed, abs(end - start) / (0.8 * style.angular_speed))
+    n = max(2, int(np.ceil(duration / world.dt)))
+    for i in range(1, n + 1):
+        s = i / n
+        theta = start + (end - start) * s * s * (3.0 - 2.0 * s)
+        yield Segment({arm: pose_at(float(theta))}, speed=2.0 * speed, label=label)
 
 
 def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan:
@@ -459,8 +549,10 @@ def plan_bimanual_lift(world: World, style: Style, roles: dict[str, str], by: fl
         chosen[arm] = grasps.handle_grasp(world, arm, obj, name)
     yield Segment(grippers={a: 1.0 for a in chosen}, gripper_steps=style.gripper_steps,
                   label="open")
-    for arm, g in chosen.items():  # one arm after the other to the pre-grasp
-        yield from transit(world, style, arm, g.pose.moved(-0.1 * g.approach), exclude=(obj,))
+    for arm, g in chosen.items():  # one arm after the other to the pre-grasp, on the
+        # IK branch from which the line on to the handle is followed
+        yield from transit(world, style, arm, g.pose.moved(-0.1 * g.approach), exclude=(obj,),
+                           then=g.pose)
     yield Segment({a: g.pose for a, g in chosen.items()}, speed=style.approach_speed,
                   label="reach handles")
     held = grip_force(world, obj, style, weight_factor=1.5)
@@ -561,7 +653,8 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
                        then=take.pose)
     yield Segment({taker: take.pose.moved(0.02 * UP)}, speed=style.approach_speed, label="to end")
     yield Segment({taker: take.pose}, speed=0.5 * style.approach_speed, label="to end")
-    gripped = grip_force(world, obj, style)
+    # the taker ends up holding the object alone, by its end: firm enough not to pivot
+    gripped = grip_force(world, obj, style, lever=grasp_lever(world, taker, obj, take.pose))
     yield Segment(grippers={taker: opening_for(world, taker, width, gripped)},
                   gripper_steps=style.gripper_steps, settle=style.settle, label="take")
     yield Segment(grippers={giver: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
@@ -575,7 +668,8 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
                     and getattr(b.asset, "support_height", None) is not None), None)
     spot = (_place_point(world, style, obj, support) if support is not None
             else np.array([mid[0], mid[1], 0.0]))
-    yield from place(world, style, taker, obj, spot)
+    # let go with the fingers 1 cm clear: no contact flicker that reads as a new grasp
+    yield from place(world, style, taker, obj, spot, release_gap=0.01)
     yield from _retreat_home(world, style, taker)
 
 

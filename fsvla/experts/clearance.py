@@ -1,0 +1,143 @@
+"""How far an arm's links stay from the hazards that watch them, for a joint configuration.
+
+The careful expert plans the TCP's path around the hazards (``skills.transit``), but the
+rest of the arm follows wherever the IK puts it: a Panda reaching low beside a no-go
+column can swing its forearm (``panda_link5``, whose wrist housing stands 13 cm off the
+forearm's axis) into the column while its hand is far from it. :class:`ArmClearance`
+measures, for arm joints ``q``, the smallest distance from the vertices of the links a
+distance channel watches (``robot``, ``gripper``, …) to that channel's reference (a
+zone's region, a hazard body's bounds), less the channel's hard limit, so that the IK can
+choose, among the answers for one pose, one that keeps the arm out of the keep-out
+distances (:meth:`fsvla.experts.motion.ArmDriver.solve_anywhere`).
+
+Vertices of the convex collision hulls are a slight over-estimate of the true distance
+(a face may pass closer than its corners); callers keep a few centimetres in hand.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fsvla.compiler.monitor import RobotEntity, ZoneEntity
+from fsvla.embodiments.frames import quat_to_matrix
+
+from .world import World
+
+#: Distance channels whose robot subjects the arm's links are checked against.
+METRICS = ("clearance", "zone_distance", "untouched", "do_not_disturb")
+
+
+class ArmClearance:
+    """Smallest (distance − hard limit) of an arm's watched links to their hazards (m)."""
+
+    def __init__(self, world: World, arm: str) -> None:
+        self.world = world
+        self.kin = world.kinematics(arm)
+        articulation = self.kin.arm.articulation
+        self._root = articulation.get_root_pose()
+        names = [lk.name for lk in articulation.get_links()]
+        links = {e.name: {r.link for r in e.links} for e in world.monitor.entities
+                 if isinstance(e, RobotEntity)}
+        regions = {e.name for e in world.monitor.entities
+                   if isinstance(e, ZoneEntity) and e.geometry == "region"}
+        zones = {z.name: z for z in world.scene.zones}
+        # links held by the hand (the hand itself, its fingers, the flange): where the TCP
+        # goes they go, whatever the joints; the TCP's path keeps them clear, not the IK
+        rigid = self._hand_rigid(names)
+        self._checks: list[tuple[list[int], str, float]] = []  # (link indices, reference, limit)
+        for channel in world.monitor.channels:
+            if channel.metric not in METRICS or channel.reference is None:
+                continue
+            watched = set().union(*(links.get(s, set()) for s in channel.subjects))
+            root = self.kin.arm.base_link.name  # the base does not move: no choice to make
+            indices = sorted(names.index(n) for n in watched
+                             if n in names and n != root and names.index(n) not in rigid)
+            ref = channel.reference
+            if not indices or (ref in zones and ref not in regions):
+                continue  # no link of this arm, or a corridor (its walls, not its region)
+            if ref not in zones and ref not in {b.name for b in world.scene.bodies}:
+                continue
+            self._checks.append((indices, ref, float(channel.limit)))
+        self._zones = zones
+        self._vertices: dict[int, NDArray[np.float64]] = {}
+        for i in {i for indices, _, _ in self._checks for i in indices}:
+            link = articulation.get_links()[i]
+            parts = []
+            for shape in link.collision_shapes:
+                if not hasattr(shape, "get_vertices"):
+                    continue
+                v = np.asarray(shape.get_vertices(), dtype=np.float64) * np.asarray(shape.scale)
+                pose = shape.local_pose
+                parts.append(v @ quat_to_matrix(pose.q).T + np.asarray(pose.p))
+            if parts:
+                self._vertices[i] = np.concatenate(parts)
+
+    def _hand_rigid(self, names: list[str]) -> set[int]:
+        """Indices of the links whose pose relative to the TCP no joint of the arm moves."""
+        model, kin = self.kin._model, self.kin
+        home = np.asarray(kin.arm.spec.home, dtype=np.float64)
+        rng = np.random.default_rng(0)
+        relative = []
+        for q in (home, home + rng.uniform(-0.3, 0.3, home.shape)):
+            model.compute_forward_kinematics(kin._full(q))
+            ee = model.get_link_pose(kin.arm.ee_link_index)
+            relative.append([ee.inv() * model.get_link_pose(i) for i in range(len(names))])
+        rigid = set()
+        for i, (a, b) in enumerate(zip(*relative)):
+            if (np.allclose(a.p, b.p, atol=1e-5)  # float32 poses
+                    and abs(abs(float(np.dot(a.q, b.q))) - 1.0) < 1e-5):
+                rigid.add(i)
+        return rigid
+
+    @property
+    def active(self) -> bool:
+        return bool(self._checks and self._vertices)
+
+    def __call__(self, q: NDArray[np.float64]) -> float:
+        """The smallest distance (m) of a watched link of the arm at joints ``q`` to its
+        hazard, less the channel's hard limit (negative: a violation)."""
+        if not self.active:
+            return float("inf")
+        model = self.kin._model
+        model.compute_forward_kinematics(self.kin._full(q))
+        points: dict[int, NDArray[np.float64]] = {}
+        for i, v in self._vertices.items():
+            pose = self._root * model.get_link_pose(i)
+            points[i] = v @ quat_to_matrix(pose.q).T + np.asarray(pose.p)
+        best = float("inf")
+        for indices, ref, limit in self._checks:
+            pts = [points[i] for i in indices if i in points]
+            if not pts:
+                continue
+            d = self._distance(np.concatenate(pts), ref)
+            best = min(best, d - limit)
+        return best
+
+    def _distance(self, p: NDArray[np.float64], ref: str) -> float:
+        zone = self._zones.get(ref)
+        if zone is None:  # a hazard body: its bounds now
+            lo, hi = self.world.bounds(ref)
+            return _box_distance(p, lo, hi)
+        R0, p0 = quat_to_matrix(zone.pose.quaternion), np.asarray(zone.pose.position)
+        region = zone.region
+        R1, p1 = quat_to_matrix(region.pose.quaternion), np.asarray(region.pose.position)
+        local = ((p - p0) @ R0 - p1) @ R1  # into the region's frame
+        if getattr(region, "type", "") == "cylinder":
+            radial = np.linalg.norm(local[:, :2], axis=1) - float(region.radius)
+            axial = np.abs(local[:, 2]) - float(region.half_length)
+            outside = np.hypot(np.maximum(radial, 0.0), np.maximum(axial, 0.0))
+            inside = np.minimum(np.maximum(radial, axial), 0.0)
+            return float(np.min(outside + inside))
+        half = np.asarray(region.half_size, dtype=np.float64)
+        return _box_distance(local, -half, half)
+
+
+def _box_distance(p: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]) -> float:
+    gap = np.maximum(lo - p, p - hi)
+    outside = np.linalg.norm(np.maximum(gap, 0.0), axis=1)
+    inside = np.minimum(np.max(gap, axis=1), 0.0)
+    return float(np.min(outside + inside))
+
+
+__all__ = ["ArmClearance"]
