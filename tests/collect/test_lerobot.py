@@ -9,18 +9,21 @@ import numpy as np
 import pytest
 
 pa = pytest.importorskip("pyarrow")
-import pyarrow.parquet as pq  # noqa: E402
-from fsvla.collect.lerobot import DatasetMismatch, Frame, LeRobotWriter, features  # noqa: E402
+import pyarrow.parquet as pq
+
+from fsvla.collect.lerobot import DatasetMismatch, Frame, LeRobotWriter, features
+
+from .lerobot_loader import load_with_lerobot
 
 CAMERAS = {"front": (16, 24), "wrist": (16, 24)}
 
 
-def _features(cameras=CAMERAS) -> dict:  # noqa: ANN001
+def _features(cameras=CAMERAS) -> dict:
     return features(["j1", "j2", "gripper"], ["x", "y", "z", "qw", "qx", "qy", "qz"],
                     ["j1", "j2", "gripper"], cameras, 20.0)
 
 
-def _frames(n: int, value: float, cameras=CAMERAS) -> list[Frame]:  # noqa: ANN001
+def _frames(n: int, value: float, cameras=CAMERAS) -> list[Frame]:
     return [Frame(state=np.full(3, value + t, np.float32), tcp_pose=np.zeros(7, np.float32),
                   action=np.full(3, value - t, np.float32),
                   images={c: np.full((h, w, 3), (t * 20) % 255, np.uint8)
@@ -28,7 +31,7 @@ def _frames(n: int, value: float, cameras=CAMERAS) -> list[Frame]:  # noqa: ANN0
             for t in range(n)]
 
 
-def _writer(root: Path, cameras=CAMERAS) -> LeRobotWriter:  # noqa: ANN001
+def _writer(root: Path, cameras=CAMERAS) -> LeRobotWriter:
     return LeRobotWriter(root, fps=20.0, robot_type="panda", features=_features(cameras))
 
 
@@ -94,11 +97,18 @@ def test_state_only_datasets_have_no_videos(tmp_path: Path) -> None:
 
 
 def test_lerobot_reads_the_dataset(tmp_path: Path) -> None:
-    """LeRobot's own loader, where it is installed (it pulls in torch, so it is optional)."""
-    dataset_module = pytest.importorskip("lerobot.common.datasets.lerobot_dataset")
+    """LeRobot's own loader reads every frame, state and picture as written."""
     root = tmp_path / "demo"
     writer = _writer(root)
-    writer.add_episode(_frames(5, 0.0), "t")
-    dataset = dataset_module.LeRobotDataset("local/demo", root=root)
-    assert dataset.num_episodes == 1 and dataset.num_frames == 5
-    assert tuple(dataset[0]["observation.state"].shape) == (3,)
+    writer.add_episode(_frames(5, 0.0), "Lift the pot.")
+    writer.add_episode(_frames(4, 10.0), "Put the pot down.")
+    seen = load_with_lerobot(root)
+    assert (seen["version"], seen["episodes"], seen["frames"], seen["fps"]) == ("v2.1", 2, 9, 20)
+    assert seen["shapes"]["observation.state"] == [3]
+    assert seen["shapes"]["observation.images.front"] == [3, 16, 24]  # CHW float in [0, 1]
+    assert seen["tasks"] == ["Lift the pot.", "Put the pot down."]
+    assert seen["episode_index"] == [0] * 5 + [1] * 4
+    assert [s[0] for s in seen["state"]] == [0, 1, 2, 3, 4, 10, 11, 12, 13]
+    # frame t of each episode is the grey level 20 t (H.264 moves it by a few levels)
+    expected = [20 * t / 255 for t in (*range(5), *range(4))]
+    assert seen["image_means"]["observation.images.wrist"] == pytest.approx(expected, abs=0.03)
