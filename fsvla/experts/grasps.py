@@ -165,20 +165,44 @@ def _generic(world: World, arm: str, obj: str) -> list[Grasp]:
     return [top_down_grasp(world, arm, centre, closing, float(size[axis]))]
 
 
-def handle_grasp(world: World, arm: str, obj: str, handle: str) -> Grasp:
-    """A side grasp of a flat side handle (a pot's): the gripper comes horizontally from
-    outside and the fingers close across the handle's width, so that the hand lies flat
-    (a Panda hand turned with its fingers vertical would reach down into the table)."""
+def handle_grasp(world: World, arm: str, obj: str, handle: str, pitch: float = 0.0) -> Grasp:
+    """A side grasp of a flat side handle (a pot's): the gripper comes from outside,
+    horizontally or pitched down by ``pitch`` (rad), and the fingers close across the
+    handle's width, horizontally, so that the hand lies flat (a Panda hand turned with its
+    fingers vertical would reach down into the table)."""
     shape = world.shape(obj, handle)
     pose = world.body_pose(obj)
     centre = world.to_world(obj, shape.pose.position)
     outward = horizontal(centre - pose.p)
-    approach = -outward
-    closing = np.cross(UPV, approach)
+    approach = np.cos(pitch) * -outward + np.sin(pitch) * -UPV
+    closing = np.cross(UPV, -outward)
     R = world.grasp_frame(arm, approach, closing)
     tcp = centre + outward * 0.004
     width = float(np.abs(pose.R.T @ closing) @ (2 * np.asarray(shape.half_size)))
     return Grasp(Pose(tcp, R), width, approach)
+
+
+#: Pitches (deg) tried for a handle grasp, the flattest first: a handle low and close to
+#: the arm's base has no comfortable horizontal reach (the elbow folds onto its limit;
+#: lift_pot_close_arms at L1 needs 40 deg).
+HANDLE_PITCHES = (0.0, 15.0, 30.0, 40.0, 50.0, 60.0)
+
+
+def reach_handle(world: World, arm: str, obj: str, handle: str, back: float = 0.1,
+                 lift: float = 0.15) -> Grasp:
+    """The flattest :func:`handle_grasp` whose whole path is followed on one IK branch
+    inside the joint limits: down to ``back`` (m) out along the approach, in to the
+    handle, and up by ``lift`` (m); the horizontal one when no pitch is."""
+    from .skills import branch_for_path
+
+    up = np.array([0.0, 0.0, 1.0])
+    for pitch in np.deg2rad(HANDLE_PITCHES):
+        grasp = handle_grasp(world, arm, obj, handle, float(pitch))
+        pre = grasp.pose.moved(-back * grasp.approach)
+        path = (pre.moved(0.1 * up), pre, grasp.pose, grasp.pose.moved(lift * up))
+        if branch_for_path(world, arm, path) is not None:
+            return grasp
+    return handle_grasp(world, arm, obj, handle)
 
 
 _MAKERS = {
@@ -186,4 +210,4 @@ _MAKERS = {
     "bowl": _cylinder, "kettle": _cylinder, "block": _block, "knife": _knife,
 }
 
-__all__ = ["choose", "grasps", "handle_grasp"]
+__all__ = ["HANDLE_PITCHES", "choose", "grasps", "handle_grasp", "reach_handle"]

@@ -546,13 +546,13 @@ def plan_bimanual_lift(world: World, style: Style, roles: dict[str, str], by: fl
     for arm in world.arm_names:
         name = min(handles, key=lambda h: float(np.linalg.norm(
             world.to_world(obj, world.shape(obj, h).pose.position) - world.base_position(arm))))
-        chosen[arm] = grasps.handle_grasp(world, arm, obj, name)
+        chosen[arm] = grasps.reach_handle(world, arm, obj, name, lift=by)
     yield Segment(grippers={a: 1.0 for a in chosen}, gripper_steps=style.gripper_steps,
                   label="open")
     for arm, g in chosen.items():  # one arm after the other to the pre-grasp, on the
-        # IK branch from which the line on to the handle is followed
+        # IK branch from which the lines down and on to the handle are followed
         yield from transit(world, style, arm, g.pose.moved(-0.1 * g.approach), exclude=(obj,),
-                           then=g.pose)
+                           then=g.pose, follow=(g.pose,))
     yield Segment({a: g.pose for a, g in chosen.items()}, speed=style.approach_speed,
                   label="reach handles")
     held = grip_force(world, obj, style, weight_factor=1.5)
