@@ -187,7 +187,8 @@ class Probe:
         self.maxima = ContactMaxima()
         # (id(body0), id(body1)) -> their frames if the scan keeps the pair, else None; the
         # bodies are the components above and the scene's other bodies, alive as long as it
-        self._scan_pairs: dict[tuple[int, int], tuple[str, str] | None] = {}
+        self._scan_pairs: dict[tuple[int, int], tuple[str, str, bool, bool] | None] = {}
+        self._last_pairs: dict[tuple[int, int], tuple[str, str] | None] = {}
         self._scan_hot, self._last_hot = self._hot(scan), self._hot(last)
         self._scan_guard, self._last_guard = self._guard(scan), self._guard(last)
         # What the last reading found, valid while every guard body sleeps (see _asleep):
@@ -278,35 +279,51 @@ class Probe:
 
     def _scan(self, inv_dt: float) -> list[tuple[str, str, str, float]]:
         """Fold the wanted contacts into the maxima; returns what it folded in."""
-        maxima, torque, cache, wants = self.maxima, self._torque, self._scan_pairs, self._filter.wants
-        hot, records = self._scan_hot, []
+        maxima, cache, hot, records = self.maxima, self._scan_pairs, self._scan_hot, []
+        centres: dict[int, tuple[float, float, float]] = {}  # torque bodies' mass centres, this substep
         for contact in self._contacts():
             b0, b1 = contact.bodies
-            if b0 not in hot and b1 not in hot:  # identity: a component's wrapper is unique
-                continue
             key = (id(b0), id(b1))
-            frames = cache.get(key, False)
-            if frames is False:
-                frames = cache[key] = self._pair(b0, b1, wants)
-            if frames is None:
+            plan = cache.get(key, False)
+            if plan is False:  # identity: a component's wrapper is unique
+                plan = cache[key] = self._scan_plan(b0, b1) if b0 in hot or b1 in hot else None
+            if plan is None:
                 continue
-            f0, f1 = frames
+            f0, f1, torque0, torque1 = plan
             points = contact.points
-            impulse = sum((p.impulse for p in points), np.zeros(3))
-            magnitude = float(np.sqrt(impulse @ impulse)) * inv_dt
+            if not (torque0 or torque1):
+                x, y, z = _impulse(points)
+                magnitude = math.sqrt(x * x + y * y + z * z) * inv_dt
+                if magnitude > 0.0:
+                    maxima.add_force(f0, f1, magnitude)
+                    records.append(("f", f0, f1, magnitude))
+                continue
+            impulses = [p.impulse.tolist() for p in points]
+            positions = [p.position.tolist() for p in points]
+            x = y = z = 0.0
+            for a, b, c in impulses:
+                x, y, z = x + a, y + b, z + c
+            magnitude = math.sqrt(x * x + y * y + z * z) * inv_dt
             if magnitude <= 0.0:
                 continue
             maxima.add_force(f0, f1, magnitude)
             records.append(("f", f0, f1, magnitude))
-            if f0 in torque:
-                value = _torque_about(b0, points, inv_dt)
-                maxima.add_torque(f0, f1, value)
-                records.append(("t", f0, f1, value))
-            if f1 in torque:
-                value = _torque_about(b1, points, inv_dt)
-                maxima.add_torque(f1, f0, value)
-                records.append(("t", f1, f0, value))
+            for torque, body, frame, other in ((torque0, b0, f0, f1), (torque1, b1, f1, f0)):
+                if torque:
+                    centre = centres.get(id(body))
+                    if centre is None:
+                        centre = centres[id(body)] = _mass_centre(body)
+                    value = _torque(impulses, positions, centre) * inv_dt
+                    maxima.add_torque(frame, other, value)
+                    records.append(("t", frame, other, value))
         return records
+
+    def _scan_plan(self, b0: Any, b1: Any) -> tuple[str, str, bool, bool] | None:
+        """(frame 0, frame 1, torque on 0, torque on 1) of a contact pair the scan keeps."""
+        frames = self._pair(b0, b1, self._filter.wants)
+        if frames is None:
+            return None
+        return frames[0], frames[1], frames[0] in self._torque, frames[1] in self._torque
 
     def _contacts(self) -> list[Any]:
         return self._physx.get_contacts()
@@ -323,22 +340,27 @@ class Probe:
         return forces
 
     def _read_last(self) -> dict[tuple[str, str], np.ndarray]:
-        forces: dict[tuple[str, str], np.ndarray] = {}
+        totals: dict[tuple[str, str], list[float]] = {}
         inv_dt = 1.0 / self._dt
-        frame_of, wants, hot = self._frame_of.get, self._last.wants, self._last_hot
+        cache, hot, wants = self._last_pairs, self._last_hot, self._last.wants
         for contact in self._contacts():
             b0, b1 = contact.bodies
-            if b0 not in hot and b1 not in hot:
+            key = (id(b0), id(b1))
+            frames = cache.get(key, False)
+            if frames is False:
+                frames = cache[key] = self._pair(b0, b1, wants) if b0 in hot or b1 in hot else None
+            if frames is None:
                 continue
-            f0, f1 = frame_of(id(b0)), frame_of(id(b1))
-            if not wants(f0, f1):
-                continue
-            f0 = f0 or f"?{b0.entity.name}"
-            f1 = f1 or f"?{b1.entity.name}"
-            force = sum((p.impulse for p in contact.points), np.zeros(3)) * inv_dt
-            forces[(f0, f1)] = forces.get((f0, f1), np.zeros(3)) + force
-            forces[(f1, f0)] = forces.get((f1, f0), np.zeros(3)) - force
-        return forces
+            f0, f1 = frames
+            x, y, z = _impulse(contact.points)
+            for key, sign in (((f0, f1), inv_dt), ((f1, f0), -inv_dt)):
+                total = totals.get(key)
+                if total is None:
+                    total = totals[key] = [0.0, 0.0, 0.0]
+                total[0] += sign * x
+                total[1] += sign * y
+                total[2] += sign * z
+        return {k: np.array(v) for k, v in totals.items()}
 
     def poses(self) -> PoseMap:
         if not self._pose_frames:
@@ -388,14 +410,32 @@ def _asleep(guard: tuple[tuple[Any, str], ...] | None) -> bool:
     return True
 
 
-def _torque_about(body: Any, points: Any, inv_dt: float) -> float:
-    """Magnitude of the contact torque on ``body`` (the contact's first body: sign +;
-    the magnitude is the same for the second) about its centre of mass."""
-    centre = np.asarray((body.entity_pose * body.cmass_local_pose).p, dtype=np.float64)
-    torque = np.zeros(3)
+def _impulse(points: Any) -> tuple[float, float, float]:
+    """Total impulse of a contact's points (plain floats: numpy's per-call overhead would
+    dominate a handful of three-vectors)."""
+    x = y = z = 0.0
     for p in points:
-        torque += np.cross(np.asarray(p.position) - centre, p.impulse)
-    return float(np.sqrt(torque @ torque)) * inv_dt
+        a, b, c = p.impulse.tolist()
+        x, y, z = x + a, y + b, z + c
+    return x, y, z
+
+
+def _mass_centre(body: Any) -> tuple[float, float, float]:
+    return tuple((body.entity_pose * body.cmass_local_pose).p.tolist())
+
+
+def _torque(impulses: list[list[float]], positions: list[list[float]],
+            centre: tuple[float, float, float]) -> float:
+    """Magnitude of the torque of impulses at positions about ``centre`` (the same for
+    both bodies of a contact: their impulses are opposite)."""
+    cx, cy, cz = centre
+    tx = ty = tz = 0.0
+    for (ix, iy, iz), (px, py, pz) in zip(impulses, positions):
+        rx, ry, rz = px - cx, py - cy, pz - cz
+        tx += ry * iz - rz * iy
+        ty += rz * ix - rx * iz
+        tz += rx * iy - ry * ix
+    return math.sqrt(tx * tx + ty * ty + tz * tz)
 
 
 __all__ = ["NET", "ContactFilter", "Probe", "components_of"]
