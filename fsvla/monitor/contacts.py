@@ -80,7 +80,7 @@ def predicate_filter(spec: MonitorSpec, layout: Layout) -> ContactFilter:
 class ContactGate:
     """Whether the per-substep scan and the predicates' contact reading can find anything
     in the next control step: robot-link pieces against body pieces within
-    :data:`CONTACT_GATE`, tested first on frame bounds (``SceneGeometry.frame_gaps``; a
+    :data:`CONTACT_GATE`, tested first on frame bounds (``SceneGeometry.frames_within``; a
     frame's bounds hold its pieces', so far frames rule their pieces out) and on pieces
     only where a frame is near. A filter that counts every contact of a non-robot frame
     is never gated."""
@@ -106,9 +106,6 @@ class ContactGate:
         self._cols = self._cols_all[cols]
         self._scan_cols, self._last_cols = scan_cols[cols], last_cols[cols]
         self._frames = self.rows | self.cols
-        n = len(index(geometry.frames))
-        self._robot_vs_cols = self._rows_all[:, None] * n + self._cols
-        self._scan_vs_all = None if self._scan_rows is None else self._scan_rows[:, None] * n + self._cols_all
         # the piece-level test, run only where the frame-level one finds something near
         piece_rows = np.isin(ia, geometry.pieces(robot_any))
         self._piece_scan_cols = np.isin(ib, geometry.pieces(scan.robot_pairs)) & self.wants_scan
@@ -121,18 +118,14 @@ class ContactGate:
         """The piece-level verdicts asked for (False for the others)."""
         geometry, scan, last = self.geometry, False, False
         if check_scan and self._piece_rows is not None:
-            scan = bool(geometry.near_pieces(self._piece_rows, self._ib, CONTACT_GATE).any())
+            scan = geometry.pieces_within(self._piece_rows, self._ib, CONTACT_GATE)
         check_scan = check_scan and not scan
         cols = (self._piece_scan_cols & check_scan) | (self._piece_last_cols & check_last)
         if cols.any():
-            touched = geometry.near_pieces(self._ia, self._ib[cols], CONTACT_GATE).any(axis=0)
+            touched = geometry.piece_columns_within(self._ia, self._ib[cols], CONTACT_GATE)
             scan = scan or (check_scan and bool((touched & self._piece_scan_cols[cols]).any()))
             last = check_last and bool((touched & self._piece_last_cols[cols]).any())
         return scan, last
-
-    def _near(self, flat: NDArray[np.int64]) -> NDArray[np.bool_]:
-        """Frame pairs (flat indices into frame_gaps' first two axes) within the gate."""
-        return (self.geometry.frame_gaps().reshape(-1, 3)[flat] < CONTACT_GATE).all(axis=2)
 
     def update(self) -> tuple[bool, bool]:
         """(scan substeps, read the last substep's contacts) for the next control step."""
@@ -142,10 +135,12 @@ class ContactGate:
         scan, last = self.scan_always, self.last_always
         if not (scan and last) and len(self._rows_all):
             # frame bounds hold their pieces' bounds: far frames rule pieces out at once
-            touched = self._near(self._robot_vs_cols).any(axis=0)
+            geometry = self.geometry
+            touched = geometry.frame_columns_within(self._rows_all, self._cols, CONTACT_GATE)
             maybe_scan = not scan and self.wants_scan and (
                 bool((touched & self._scan_cols).any())
-                or (self._scan_vs_all is not None and bool(self._near(self._scan_vs_all).any())))
+                or (self._scan_rows is not None
+                    and geometry.frames_within(self._scan_rows, self._cols_all, CONTACT_GATE)))
             maybe_last = not last and self.wants_last and bool((touched & self._last_cols).any())
             if maybe_scan or maybe_last:  # the same verdict as a piece-level gate
                 near_scan, near_last = self._pieces_near(maybe_scan, maybe_last)

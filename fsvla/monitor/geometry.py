@@ -4,11 +4,11 @@ Every frame (a rigid body, an articulated body's link, a robot link, a zone) own
 pieces built by ``fsvla.compiler.collision.pieces_of`` from compiler ``Shape`` models:
 bodies and zones from the SceneSpec, robot links from their SAPIEN collision shapes
 (:func:`shapes_of_sapien`). Each step :meth:`SceneGeometry.set_poses` moves the world
-axis-aligned bounds of every piece in one vectorised pass; FCL transforms are set
-lazily, only for pieces an exact query touches. :meth:`SceneGeometry.prefetch` bounds
-every frame (the box around its pieces) and gives each distance query of a step the gap
-between its groups' nearest frames, in one pass; a query already that far answers with
-it. Otherwise :meth:`SceneGeometry.distance` visits the piece pairs of two groups in
+axis-aligned bounds of every piece, and of every frame (the box around its pieces), in
+one compiled pass (``fsvla.monitor.kernels``); FCL transforms are set lazily, only for
+pieces an exact query touches. :meth:`SceneGeometry.prefetch` gives each distance query
+of a step the gap between its groups' nearest frames, in one call; a query already that
+far answers with it. Otherwise :meth:`SceneGeometry.distance` visits the piece pairs of two groups in
 order of their bounds' gap and stops once that gap exceeds the best exact distance found
 (or, overlapping pieces found, once bounds stop overlapping: the deepest penetration),
 so the minimum is exact while far pairs cost nothing. Given ``exact_below`` it also
@@ -40,6 +40,7 @@ from fsvla.compiler.assets.model import (
 )
 from fsvla.compiler.collision import CollisionPiece, fcl_transform, pieces_of, signed_distance
 
+from . import kernels
 from .state import Matrix4
 
 #: Distances are capped here (m): a group with no geometry, or nothing in range.
@@ -109,7 +110,7 @@ class SceneGeometry:
     def __init__(self) -> None:
         self._pieces: list[CollisionPiece] = []
         self._piece_frame: list[int] = []
-        self._centers: list[NDArray[np.float64]] = []
+        self._centres: list[NDArray[np.float64]] = []
         self._halves: list[NDArray[np.float64]] = []
         self._points: list[NDArray[np.float64]] = []
         self.frames: list[str] = []
@@ -154,7 +155,7 @@ class SceneGeometry:
             self._frame_pieces[frame].append(len(self._pieces))
             self._pieces.append(piece)
             self._piece_frame.append(index)
-            self._centers.append((lo + hi) / 2.0)
+            self._centres.append((lo + hi) / 2.0)
             self._halves.append((hi - lo) / 2.0)
             self._points.append(points)
             self._placed.append(-1)
@@ -164,12 +165,11 @@ class SceneGeometry:
         if hasattr(self, "_pose_array"):  # frames added after queries keep the others' poses
             for i, pose in enumerate(self._pose_array):
                 self._poses[i] = pose
-        self._c = np.array(self._centers, dtype=np.float64).reshape(-1, 3)
+        self._c = np.array(self._centres, dtype=np.float64).reshape(-1, 3)
         self._h = np.array(self._halves, dtype=np.float64).reshape(-1, 3)
         self._pf = np.array(self._piece_frame, dtype=np.int64)
         self._pose_array = np.array(self._poses, dtype=np.float64).reshape(-1, 4, 4)
-        self._wc = np.zeros_like(self._c)
-        self._wh = np.zeros_like(self._h)
+        self._plo, self._phi = np.zeros_like(self._c), np.zeros_like(self._c)
         self._groups.clear()
         self._moves.clear()
         self._group_frames.clear()
@@ -180,13 +180,13 @@ class SceneGeometry:
         self._bounds_memo.clear()
         self._point_memo.clear()
         self._stamp = np.array(self._stamp, dtype=np.int64)
-        # pieces grouped by frame, for the frames' world bounds (frame_gaps)
-        order = np.argsort(self._pf, kind="stable")
-        self._by_frame = None if np.array_equal(order, np.arange(len(order))) else order
+        # the frames with pieces, in frame order, are the rows of the frame bounds
         counts = np.bincount(self._pf, minlength=len(self.frames))
-        self._frame_starts = (np.cumsum(counts) - counts)[counts > 0]
         self._gap_rows = {f: r for r, f in enumerate(f for f, n in zip(self.frames, counts.tolist()) if n)}
-        self._frames_dirty = True
+        row_of_frame = np.cumsum(counts > 0) - 1
+        self._piece_row = row_of_frame[self._pf].astype(np.int64)
+        self._flo = np.zeros((len(self._gap_rows), 3))
+        self._fhi = np.zeros((len(self._gap_rows), 3))
         self._frame_points = {f: np.concatenate([self._points[i] for i in idx]) for f, idx in self._frame_pieces.items()
                               if idx}
         self._update_bounds()
@@ -220,26 +220,17 @@ class SceneGeometry:
         if stack is None:
             values = list(poses.values())
             stack = np.array(values if keep is None else [values[i] for i in keep], dtype=np.float64)
-        else:
-            stack = stack.astype(np.float64) if keep is None else stack[keep].astype(np.float64)
-        moved = np.abs(stack - self._pose_array[frames]).reshape(len(frames), 16).max(axis=1) > POSE_TOLERANCE
-        if not moved.any():
-            return
-        frames = frames[moved]
-        self._pose_array[frames] = stack[moved]
-        self._stamp[frames] += 1
-        self._update_bounds()
+        elif keep is not None:
+            stack = stack[keep]
+        if kernels.apply_poses(stack, frames, self._pose_array, self._stamp, POSE_TOLERANCE):
+            self._update_bounds()
 
     def _update_bounds(self) -> None:
-        """Every piece's world bounds (one pass over all pieces is cheaper than picking the
-        moved ones; the others get the same numbers again)."""
-        if not len(self._pf):
-            return
-        poses = self._pose_array[self._pf]
-        rot = poses[:, :3, :3]
-        np.add(np.einsum("pij,pj->pi", rot, self._c), poses[:, :3, 3], out=self._wc)
-        np.einsum("pij,pj->pi", np.abs(rot), self._h, out=self._wh)
-        self._frames_dirty = True
+        """Every piece's and every frame's world bounds (one pass over all pieces is cheaper
+        than picking the moved ones; the others get the same numbers again)."""
+        if len(self._pf):
+            kernels.update_bounds(self._pose_array, self._pf, self._c, self._h, self._piece_row,
+                                  self._plo, self._phi, self._flo, self._fhi)
 
     def pose(self, frame: str) -> Matrix4:
         if not self._frozen:
@@ -296,44 +287,43 @@ class SceneGeometry:
         plan = self._batches.get(queries)
         if plan is None:
             plan = self._batches[queries] = self._batch_plan(queries)
-        keys, frames, frame_starts, flat, starts = plan
+        keys, frames, frame_starts, rows_a, rows_b, starts = plan
         if not keys:
             return
         versions = np.add.reduceat(self._stamp[frames], frame_starts).tolist()
-        if not len(self._frame_starts):
-            return
-        gap = np.maximum(self.frame_gaps(), 0.0)
-        bound = np.sqrt(np.einsum("abk,abk->ab", gap, gap)).ravel()
-        nearest = np.minimum.reduceat(bound[flat], starts).tolist()
-        self._prefetched = dict(zip(keys, zip(versions, nearest)))
+        nearest = np.empty(len(keys))
+        kernels.nearest_per_query(self._flo, self._fhi, rows_a, rows_b, starts, nearest)
+        self._prefetched = dict(zip(keys, zip(versions, nearest.tolist())))
 
-    def frame_gaps(self) -> NDArray[np.float64]:
-        """(F, F, 3) for the F frames with pieces (rows: :meth:`frame_indices`): per axis,
-        the gap between the world bounds of two frames' pieces (negative where they
-        overlap on that axis), a lower bound of the gap between any of their pieces."""
-        if not self._frozen:
-            self._freeze()
-        if self._frames_dirty:
-            self._frames_dirty = False
-            lo, hi = self._wc - self._wh, self._wc + self._wh
-            if self._by_frame is not None:
-                lo, hi = lo[self._by_frame], hi[self._by_frame]
-            lo = np.minimum.reduceat(lo, self._frame_starts)
-            hi = np.maximum.reduceat(hi, self._frame_starts)
-            self._frame_gaps = np.maximum(lo[None, :, :] - hi[:, None, :], lo[:, None, :] - hi[None, :, :])
-        return self._frame_gaps
+    def frames_within(self, rows: NDArray[np.int64], cols: NDArray[np.int64], gap: float) -> bool:
+        """Whether the world bounds of a frame of ``rows`` and one of ``cols`` (rows of
+        :meth:`frame_indices`) are apart by less than ``gap`` on every axis."""
+        return bool(kernels.any_within(self._flo, self._fhi, rows, cols, gap))
+
+    def frame_columns_within(self, rows: NDArray[np.int64], cols: NDArray[np.int64],
+                             gap: float) -> NDArray[np.bool_]:
+        """Per frame of ``cols``: :meth:`frames_within` of it and ``rows``."""
+        return kernels.columns_within(self._flo, self._fhi, rows, cols, gap)
+
+    def pieces_within(self, ia: NDArray[np.int64], ib: NDArray[np.int64], gap: float) -> bool:
+        """:meth:`frames_within` for pieces (indices as :meth:`pieces` gives them)."""
+        return bool(kernels.any_within(self._plo, self._phi, ia, ib, gap))
+
+    def piece_columns_within(self, ia: NDArray[np.int64], ib: NDArray[np.int64],
+                             gap: float) -> NDArray[np.bool_]:
+        """:meth:`frame_columns_within` for pieces."""
+        return kernels.columns_within(self._plo, self._phi, ia, ib, gap)
 
     def frame_indices(self, frames: Iterable[str]) -> NDArray[np.int64]:
-        """Rows of :meth:`frame_gaps` for those of ``frames`` that have pieces (sorted)."""
+        """Rows of the frame bounds for those of ``frames`` that have pieces (sorted)."""
         if not self._frozen:
             self._freeze()
         rows = self._gap_rows
         return np.array(sorted(rows[f] for f in frames if f in rows), dtype=np.int64)
 
     def _batch_plan(self, queries: tuple[tuple[frozenset[str], frozenset[str]], ...]) -> tuple:
-        keys, frames, frame_starts, flat, starts = [], [], [], [], []
+        keys, frames, frame_starts, rows_a, rows_b, starts = [], [], [], [], [], []
         rows, count = self._gap_rows, 0
-        n_frames = len(rows)
         for a, b in dict.fromkeys(queries):
             ia, ib, fr, _ = self._pair(a, b)
             if len(ia) == 0 or len(ib) == 0:
@@ -344,12 +334,14 @@ class SceneGeometry:
             frame_starts.append(count)
             count += len(fr)
             frames.append(fr)
-            starts.append(len(flat))
-            flat += [x * n_frames + y for x in fa for y in fb]
+            starts.append(len(rows_a))
+            rows_a += [x for x in fa for _ in fb]
+            rows_b += [y for _ in fa for y in fb]
         if not keys:
-            return ((), None, None, None, None)
-        return (tuple(keys), np.concatenate(frames), np.array(frame_starts, dtype=np.int64),
-                np.array(flat, dtype=np.int64), np.array(starts, dtype=np.int64))
+            return ((), None, None, None, None, None)
+        as_index = lambda v: np.array(v, dtype=np.int64)  # noqa: E731
+        return (tuple(keys), np.concatenate(frames), as_index(frame_starts), as_index(rows_a),
+                as_index(rows_b), as_index(starts))
 
     def distance(self, a: frozenset[str], b: frozenset[str], exact_below: float = MAX_DISTANCE) -> float:
         """Smallest signed distance between the pieces of two frame groups (negative when
@@ -372,11 +364,8 @@ class SceneGeometry:
         if found is not None and found[0] == version and found[1] >= exact_below:
             self._memo[key] = (found[1], exact_below, version)  # far at the frame level already
             return found[1]
-        wc, wh = self._wc, self._wh
-        gap = np.abs(wc[ia][:, None, :] - wc[ib][None, :, :])
-        gap -= wh[ia][:, None, :] + wh[ib][None, :, :]
-        np.maximum(gap, 0.0, out=gap)
-        bound = np.sqrt(np.einsum("abk,abk->ab", gap, gap)).ravel()
+        bound = np.empty(len(ia) * len(ib))
+        kernels.pair_distances(self._plo, self._phi, ia, ib, bound)
         nearest = float(bound.min())
         if nearest >= exact_below:  # every pair is far: the broad phase answers
             self._memo[key] = (nearest, exact_below, version)
@@ -405,25 +394,6 @@ class SceneGeometry:
     def pieces(self, frames: frozenset[str]) -> NDArray[np.int64]:
         """Indices of the frames' pieces (sorted), as the rows/columns of :meth:`near`."""
         return self._group(frames)
-
-    def near(self, a: frozenset[str], b: frozenset[str], gap: float) -> NDArray[np.bool_]:
-        """Piece pairs (rows: ``a``'s pieces, columns: ``b``'s) whose bounds are within ``gap``
-        on every axis (broad phase only)."""
-        if not self._frozen:
-            self._freeze()
-        ia, ib = self._group(a), self._group(b)
-        d = np.abs(self._wc[ia][:, None, :] - self._wc[ib][None, :, :])
-        d -= self._wh[ia][:, None, :] + self._wh[ib][None, :, :]
-        return np.all(d < gap, axis=2)
-
-    def near_pieces(self, ia: NDArray[np.int64], ib: NDArray[np.int64], gap: float) -> NDArray[np.bool_]:
-        """:meth:`near` for piece indices (rows ``ia``, columns ``ib``)."""
-        if not self._frozen:
-            self._freeze()
-        wc, wh = self._wc, self._wh
-        d = np.abs(wc[ia][:, None, :] - wc[ib][None, :, :])
-        d -= wh[ia][:, None, :] + wh[ib][None, :, :]
-        return (d < gap).all(axis=2)
 
     def points(self, frames: frozenset[str]) -> NDArray[np.float64]:
         """World sample points of the frames' geometry (vertices, rims of round shapes)."""
@@ -456,7 +426,7 @@ class SceneGeometry:
         cached = self._bounds_memo.get(frames)
         if cached is not None and cached[0] == version:
             return cached[1]
-        found = (self._wc[idx] - self._wh[idx]).min(axis=0), (self._wc[idx] + self._wh[idx]).max(axis=0)
+        found = self._plo[idx].min(axis=0), self._phi[idx].max(axis=0)
         self._bounds_memo[frames] = (version, found)
         return found
 
