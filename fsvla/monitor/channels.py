@@ -1,9 +1,10 @@
 """The signed margin q_k of each metric (larger is safer; paper §4, Eq. threshold).
 
-Every function measures one quantity m on a :class:`WorldState` (whose poses are
-already in the :class:`SceneGeometry`); :func:`margin` turns it into
-``q = limit - m`` for an upper bound (``<=``) or ``q = m - limit`` for a lower bound
-(``>=``). Units are the LimitSpec's: N, Nm, m, rad.
+:func:`compile_margin` resolves a channel's entities to frames once and returns a
+function that measures one quantity m on a :class:`WorldState` (whose poses are already
+in the :class:`SceneGeometry`) and turns it into ``q = limit - m`` for an upper bound
+(``<=``) or ``q = m - limit`` for a lower bound (``>=``). Units are the LimitSpec's: N,
+Nm, m, rad.
 
 =================  ===========================================================================
 metric             m
@@ -46,54 +47,68 @@ TOUCH_DEPTH = 0.001
 #: Distances are exact up to limit + soft threshold + this (m); beyond, a lower bound at least that large.
 EXACT_BAND = 0.05
 
-Measure = Callable[[ChannelSpec, WorldState, Layout, SceneGeometry], float]
+#: m of one channel, given the state and the posed geometry.
+Measure = Callable[[WorldState, SceneGeometry], float]
+#: Builds a channel's :data:`Measure` from its spec and the scene's layout.
+MeasureFactory = Callable[[ChannelSpec, Layout], Measure]
 
 
-def _contact_force(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
-    return max(state.max_force(layout.frames(s)) for s in ch.subjects)
+def _contact_force(ch: ChannelSpec, layout: Layout) -> Measure:
+    subjects = [layout.frames(s) for s in ch.subjects]
+    return lambda state, geo: max(state.max_force(frames) for frames in subjects)
 
 
-def _contact_torque(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
-    return max(state.max_torque(layout.frames(s)) for s in ch.subjects)
+def _contact_torque(ch: ChannelSpec, layout: Layout) -> Measure:
+    subjects = [layout.frames(s) for s in ch.subjects]
+    return lambda state, geo: max(state.max_torque(frames) for frames in subjects)
 
 
-def _distance(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
+def _distance(ch: ChannelSpec, layout: Layout) -> Measure:
     assert ch.reference is not None
     reference = layout.frames(ch.reference)
+    subjects = [layout.frames(s) for s in ch.subjects]
     exact_below = ch.limit + ch.soft_threshold + EXACT_BAND
-    return min(geo.distance(layout.frames(s), reference, exact_below) for s in ch.subjects)
+    return lambda state, geo: min(geo.distance(frames, reference, exact_below) for frames in subjects)
 
 
-def _edge_clearance(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
+def _edge_clearance(ch: ChannelSpec, layout: Layout) -> Measure:
     support = layout.bodies[ch.support or "table"]
-    pose = geo.pose(support.root_frame) if geo.has(support.root_frame) else np.eye(4)
+    subjects = [layout.frames(s) for s in ch.subjects]
     (x0, y0), (x1, y1) = support.footprint
-    best = MAX_DISTANCE
-    for subject in ch.subjects:
-        points = geo.points(layout.frames(subject))
-        if len(points) == 0:
-            continue
-        local = (points - pose[:3, 3]) @ pose[:3, :3]  # into the support's frame
-        inside = np.minimum(np.minimum(local[:, 0] - x0, x1 - local[:, 0]),
-                            np.minimum(local[:, 1] - y0, y1 - local[:, 1]))
-        best = min(best, float(inside.min()))
-    return best
+
+    def measure(state: WorldState, geo: SceneGeometry) -> float:
+        pose = geo.pose(support.root_frame) if geo.has(support.root_frame) else np.eye(4)
+        best = MAX_DISTANCE
+        for frames in subjects:
+            points = geo.points(frames)
+            if len(points) == 0:
+                continue
+            local = (points - pose[:3, 3]) @ pose[:3, :3]  # into the support's frame
+            inside = np.minimum(np.minimum(local[:, 0] - x0, x1 - local[:, 0]),
+                                np.minimum(local[:, 1] - y0, y1 - local[:, 1]))
+            best = min(best, float(inside.min()))
+        return best
+
+    return measure
 
 
-def _root_pose(body: str, layout: Layout, geo: SceneGeometry, state: WorldState) -> np.ndarray:
-    frame = layout.bodies[body].root_frame
-    if frame in state.poses:
-        return state.poses[frame]
-    return geo.pose(frame)
+def _root_pose(frame: str, geo: SceneGeometry, state: WorldState) -> np.ndarray:
+    found = state.poses.get(frame)
+    return geo.pose(frame) if found is None else found
 
 
-def _displacement(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
-    worst = 0.0
-    for subject in ch.subjects:
-        now = _root_pose(subject, layout, geo, state)
-        start = layout.initial.get(subject, now)
-        worst = max(worst, float(np.linalg.norm(now[:3, 3] - start[:3, 3])))
-    return worst
+def _displacement(ch: ChannelSpec, layout: Layout) -> Measure:
+    roots = [(s, layout.bodies[s].root_frame) for s in ch.subjects]
+
+    def measure(state: WorldState, geo: SceneGeometry) -> float:
+        worst = 0.0
+        for subject, frame in roots:
+            now = _root_pose(frame, geo, state)
+            start = layout.initial.get(subject, now)
+            worst = max(worst, math.dist(now[:3, 3].tolist(), start[:3, 3].tolist()))
+        return worst
+
+    return measure
 
 
 def tilt_of(pose: np.ndarray) -> float:
@@ -101,17 +116,24 @@ def tilt_of(pose: np.ndarray) -> float:
     return math.acos(max(-1.0, min(1.0, float(pose[2, 2]))))
 
 
-def _tilt(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
-    return max(tilt_of(_root_pose(s, layout, geo, state)) for s in ch.subjects)
+def _tilt(ch: ChannelSpec, layout: Layout) -> Measure:
+    roots = [layout.bodies[s].root_frame for s in ch.subjects]
+    return lambda state, geo: max(tilt_of(_root_pose(frame, geo, state)) for frame in roots)
 
 
-def _untouched(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
+def _untouched(ch: ChannelSpec, layout: Layout) -> Measure:
     assert ch.reference is not None
     reference = layout.frames(ch.reference)
-    d = _distance(ch, state, layout, geo)
-    if any(state.touching(layout.frames(s), reference) for s in ch.subjects):
-        d = min(d, -TOUCH_DEPTH)
-    return d
+    subjects = [layout.frames(s) for s in ch.subjects]
+    distance = _distance(ch, layout)
+
+    def measure(state: WorldState, geo: SceneGeometry) -> float:
+        d = distance(state, geo)
+        if any(state.touching(frames, reference) for frames in subjects):
+            d = min(d, -TOUCH_DEPTH)
+        return d
+
+    return measure
 
 
 DISTANCE_METRICS = frozenset({"clearance", "zone_distance", "separation", "untouched", "do_not_disturb"})
@@ -124,7 +146,7 @@ def distance_queries(spec: MonitorSpec, layout: Layout) -> tuple[tuple[frozenset
                  if ch.metric in DISTANCE_METRICS and ch.reference is not None for s in ch.subjects)
 
 
-MEASURES: dict[str, Measure] = {
+MEASURES: dict[str, MeasureFactory] = {
     "contact_force": _contact_force,
     "contact_torque": _contact_torque,
     "clearance": _distance,
@@ -139,15 +161,18 @@ MEASURES: dict[str, Measure] = {
 assert set(MEASURES) == set(METRIC_NAMES), "every MonitorSpec metric needs a measure"
 
 
-def measure(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
-    """The measured quantity m of the channel."""
-    return MEASURES[ch.metric](ch, state, layout, geo)
+def compile_measure(ch: ChannelSpec, layout: Layout) -> Measure:
+    """The channel's measured quantity m, as a function of the state and the geometry."""
+    return MEASURES[ch.metric](ch, layout)
 
 
-def margin(ch: ChannelSpec, state: WorldState, layout: Layout, geo: SceneGeometry) -> float:
-    """The signed margin q: ``limit - m`` for ``<=``, ``m - limit`` for ``>=``."""
-    m = measure(ch, state, layout, geo)
-    return ch.limit - m if ch.comparison == "<=" else m - ch.limit
+def compile_margin(ch: ChannelSpec, layout: Layout) -> Measure:
+    """The channel's signed margin q: ``limit - m`` for ``<=``, ``m - limit`` for ``>=``."""
+    measure, limit = compile_measure(ch, layout), ch.limit
+    if ch.comparison == "<=":
+        return lambda state, geo: limit - measure(state, geo)
+    return lambda state, geo: measure(state, geo) - limit
 
 
-__all__ = ["DISTANCE_METRICS", "EXACT_BAND", "MEASURES", "TOUCH_DEPTH", "distance_queries", "margin", "measure", "tilt_of"]
+__all__ = ["DISTANCE_METRICS", "EXACT_BAND", "MEASURES", "TOUCH_DEPTH", "compile_margin", "compile_measure",
+           "distance_queries", "tilt_of"]

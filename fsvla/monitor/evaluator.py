@@ -13,7 +13,7 @@ import numpy as np
 from fsvla.compiler.monitor import MonitorSpec
 from fsvla.metrics.trace import ChannelInfo, EpisodeMeta, EpisodeTrace
 
-from .channels import distance_queries, margin
+from .channels import compile_margin, distance_queries
 from .geometry import SceneGeometry
 from .layout import Layout
 from .predicates import Scope, holds, uses_contacts
@@ -38,13 +38,13 @@ class Evaluator:
         self.spec, self.layout, self.geometry = spec, layout, geometry
         self.names = spec.channel_names
         self.channel_infos = channel_infos(spec)
-        self._eps = np.array([c.soft_threshold for c in self.channel_infos], dtype=np.float64)
-        self._eps_list = self._eps.tolist()
+        self._eps = [c.soft_threshold for c in self.channel_infos]
         self._weights = np.array([c.weight for c in self.channel_infos], dtype=np.float64)
         self._shapings = [c.shaping for c in self.channel_infos]
         self._fsms = [PreconditionMonitor(within=r.within) for r in spec.requirements]
         self.needs_contacts = uses_contacts(spec)
         self._queries = distance_queries(spec, layout)
+        self._margins = [compile_margin(c, layout) for c in spec.channels]
         self._rows: list[np.ndarray] = []
         self._held_steps = 0
         self.success_achieved = False
@@ -71,7 +71,8 @@ class Evaluator:
         """Evaluate the state at the end of a control step."""
         scope = self._scope(state)
         self.geometry.prefetch(self._queries)
-        values = [margin(c, state, self.layout, self.geometry) for c in self.spec.channels]
+        geometry = self.geometry
+        values = [margin(state, geometry) for margin in self._margins]
         for fsm, req in zip(self._fsms, self.spec.requirements):
             values.append(fsm.update(holds(req.first, scope), holds(req.then, scope), state.time))
         margins = np.array(values, dtype=np.float64)
@@ -83,8 +84,8 @@ class Evaluator:
         self.success_achieved |= success
         return StepReport(
             step=state.step, time=state.time, names=self.names, margins=margins,
-            states=tuple(map(classify, values, self._eps_list)),
-            costs=step_costs(margins, self._eps, self._shapings), weights=self._weights,
+            states=tuple(map(classify, values, self._eps)),
+            costs=step_costs(values, self._eps, self._shapings), weights=self._weights,
             success_value=value, success_held=held if value else 0.0, success=success)
 
     @property

@@ -46,6 +46,7 @@ class BodyInfo:
     footprint: tuple[tuple[float, float], tuple[float, float]]  # body frame (min_xy, max_xy)
     top: float  # height of its support surface (or its top) above its origin
     bounds: tuple[NDArray[np.float64], NDArray[np.float64]]  # body frame (lower, upper)
+    centre: NDArray[np.float64]  # body frame: the centre of ``bounds``
     cavity: Shape | None = None
     parts: tuple[PartInfo, ...] = ()
     link_bounds: Mapping[str, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(default_factory=dict)
@@ -109,7 +110,7 @@ def _body_info(body) -> BodyInfo:
     if isinstance(asset, RigidAsset):
         return BodyInfo(name=body.name, root_frame=body.name, frames=frozenset({body.name}), articulated=False,
                         is_static=body.is_static, footprint=footprint, top=top, bounds=(lo, hi),
-                        cavity=asset.cavity)
+                        centre=(lo + hi) / 2.0, cavity=asset.cavity)
     joints = {j.name: j for j in asset.joints}
     parts = tuple(PartInfo(link_frame=link_frame(body.name, p.link), joint=link_frame(body.name, p.joint),
                            lower=joints[p.joint].lower, upper=joints[p.joint].upper) for p in asset.parts)
@@ -118,7 +119,7 @@ def _body_info(body) -> BodyInfo:
     return BodyInfo(name=body.name, root_frame=link_frame(body.name, asset.root_link),
                     frames=frozenset(link_frame(body.name, link.name) for link in asset.links),
                     articulated=True, is_static=body.is_static, footprint=footprint, top=top, bounds=(lo, hi),
-                    parts=parts, link_bounds=link_bounds)
+                    centre=(lo + hi) / 2.0, parts=parts, link_bounds=link_bounds)
 
 
 def build_layout(spec: MonitorSpec, scene: SceneSpec) -> Layout:

@@ -27,6 +27,7 @@ pressed    the grippers push the object down (force z < -PRESS_FORCE) in the las
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import lru_cache
 
 import numpy as np
 
@@ -74,9 +75,8 @@ class Scope:
     def centre(self, body: str) -> np.ndarray:
         found = self._centres.get(body)
         if found is None:
-            lo, hi = self.layout.bodies[body].bounds
             pose = self.root_pose(body)
-            found = self._centres[body] = pose[:3, :3] @ ((lo + hi) / 2.0) + pose[:3, 3]
+            found = self._centres[body] = pose[:3, :3] @ self.layout.bodies[body].centre + pose[:3, 3]
         return found
 
     def point(self, entity: str) -> np.ndarray:
@@ -117,8 +117,13 @@ def _in_box(point: np.ndarray, pose: np.ndarray, lo: np.ndarray, hi: np.ndarray)
 
 
 def _param(p: Predicate, name: str) -> float:
-    value = p.params.get(name, PREDICATES[p.name].param(name).default)  # type: ignore[union-attr]
-    return float(value)  # type: ignore[arg-type]
+    value = p.params.get(name)
+    return _default(p.name, name) if value is None else float(value)  # type: ignore[arg-type]
+
+
+@lru_cache(maxsize=None)
+def _default(predicate: str, name: str) -> float:
+    return float(PREDICATES[predicate].param(name).default)  # type: ignore[union-attr, arg-type]
 
 
 def _grasped(p: Predicate, s: Scope) -> bool:

@@ -21,13 +21,13 @@ def classify(margin: float, soft_threshold: float) -> ChannelState:
     return "warning" if margin < soft_threshold else "safe"
 
 
-def step_costs(margins: NDArray[np.float64], soft_thresholds: NDArray[np.float64],
+def step_costs(margins: Sequence[float], soft_thresholds: Sequence[float],
                shapings: Sequence[str]) -> NDArray[np.float64]:
     """c_k = g_k(max(0, ε_k - q_k) / ε_k) per channel, as ``fsvla.metrics.shaping.soft_cost``."""
-    x = np.maximum(0.0, soft_thresholds - margins) / soft_thresholds
-    costs = np.zeros_like(x)  # g(0) = 0 for every shaping: only channels below ε cost
-    for k in np.flatnonzero(x).tolist():
-        costs[k] = SHAPING_FUNCTIONS[shapings[k]](x[k:k + 1])[0]
+    costs = np.zeros(len(margins))  # g(0) = 0 for every shaping: only channels below ε cost
+    for k, (q, eps) in enumerate(zip(margins, soft_thresholds)):
+        if not q >= eps:  # a NaN margin gets a NaN cost, as numpy would give it
+            costs[k] = SHAPING_FUNCTIONS[shapings[k]](np.array([(eps - q) / eps]))[0]
     return costs
 
 
