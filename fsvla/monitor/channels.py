@@ -25,8 +25,10 @@ do_not_disturb     robot-to-X distance (inside a zone region or penetrating X: n
 =================  ===========================================================================
 
 Distances are capped at ``MAX_DISTANCE`` (10 m), so margins stay finite, and are exact
-while below limit + ε + ``EXACT_BAND`` (5 cm); farther, the monitor reports a lower bound
-that is itself beyond that, so the state (safe) and the cost (0) are still exact.
+while below limit + ε + ``EXACT_BAND``; farther, the monitor reports a lower bound that
+is itself beyond that, so every state, cost, exposure and violation is still exact: they
+depend on q only where q < ε. ``EXACT_BAND`` is 0: exact FCL queries beyond the warning
+band would only refine plotted margins, at most of the monitor's cost (docs/monitor.md).
 """
 
 from __future__ import annotations
@@ -45,7 +47,7 @@ from .state import WorldState
 #: Depth (m) a contact counts as on an ``untouched`` channel: touching is a violation.
 TOUCH_DEPTH = 0.001
 #: Distances are exact up to limit + soft threshold + this (m); beyond, a lower bound at least that large.
-EXACT_BAND = 0.05
+EXACT_BAND = 0.0
 
 #: m of one channel, given the state and the posed geometry.
 Measure = Callable[[WorldState, SceneGeometry], float]
