@@ -8,17 +8,21 @@ and driven by the same deterministic, moving action sequence:
   gripper opens and closes every 2 s; the links sweep through the space over the table;
 - ``reach``: each arm's TCP goes, top-down, from home to above the task object (the
   success condition's first body), down to its top, closes the gripper, lifts, and back
-  (joint targets solved once by IK, so the env step has no IK in it).
+  (joint targets solved once by IK, so the env step has no IK in it);
+- ``expert``: the joint targets of one careful-expert episode of the scenario (L0, seed
+  0), recorded first and replayed: the task as a policy does it, grasps and all.
 
 Both environments step in lockstep, one control step each in turn (the order alternates),
 so each pair of steps has the same action and physical state and load from other
 processes hits both alike. Reported per scenario and motion: the median env step with
 the monitor off and on, the median of the paired differences and its ratio to the off
-step (the target: at most 15 %), and the monitor's own time per control step (its 25
-``record_substep`` calls and ``end_step``, timed in every other pair, which is then left
-out of the env-step figures).
+step, the *mean* ratio (the time the monitor added over all timed steps / their time
+with it off: what it adds to a whole episode; contact scans make the cost heavy-tailed,
+so this is the figure the target applies to: at most 15 %), and the monitor's own time
+per control step (its 25 ``record_substep`` calls and ``end_step``, timed in every other
+pair, which is then left out of the env-step figures).
 
-    python bench/monitor.py [--steps 300] [--motions sweep,reach] [--only NAME]
+    python bench/monitor.py [--steps 300] [--motions sweep,reach,expert] [--only NAME]
 
 Exit status 0 whatever the verdict: this is a benchmark.
 """
@@ -118,20 +122,39 @@ def reach_actions(env: Any, length: int) -> np.ndarray:
     return np.clip(actions, low, high).astype(np.float32)
 
 
-MOTIONS: dict[str, Callable[[Any, int], np.ndarray]] = {"sweep": sweep_actions, "reach": reach_actions}
+def expert_actions(env: Any, length: int) -> np.ndarray:
+    """The joint targets of one careful-expert episode of the env's layout (``length`` is
+    not used: the episode is as long as the expert needs)."""
+    from fsvla.experts import make_expert
+
+    expert = make_expert(env, "careful")
+    obs, _ = env.reset()
+    expert.reset(None)
+    done = False
+    while not done:
+        for action in expert.act(obs):
+            obs, _, terminated, truncated, _ = env.step(action)
+            done = terminated or truncated
+            if done:
+                break
+    return np.asarray(env.episode_record().actions, dtype=np.float32)
+
+
+MOTIONS: dict[str, Callable[[Any, int], np.ndarray]] = {
+    "sweep": sweep_actions, "reach": reach_actions, "expert": expert_actions}
 
 
 # --------------------------------------------------------------------------- timing
 
 class Runner:
-    """One env stepping through a fixed action sequence, resetting every EPISODE steps."""
+    """One env stepping through a fixed action sequence, resetting at its end."""
 
     def __init__(self, env: Any, actions: np.ndarray):
         self.env, self.actions, self.t = env, actions, 0
 
     def step(self) -> float:
         """One control step; its wall time (s)."""
-        if self.t >= EPISODE:
+        if self.t >= len(self.actions):
             self.env.reset()
             self.t = 0
         action = self.actions[self.t]
@@ -143,11 +166,11 @@ class Runner:
 
 
 class MonitorProbe:
-    """Times a monitor's record_substep and end_step by shadowing them on the instance."""
+    """Times the env's monitor's record_substep and end_step by shadowing them on the
+    instance (the env builds a new monitor with every scene, so it is looked up anew)."""
 
-    def __init__(self, monitor: Any):
-        self.monitor = monitor
-        self.record_substep, self.end_step = monitor.record_substep, monitor.end_step
+    def __init__(self, env: Any):
+        self.env = env
         self.substep_acc = 0.0
         self.substep: list[float] = []
         self.end: list[float] = []
@@ -166,6 +189,8 @@ class MonitorProbe:
         return report
 
     def __enter__(self) -> Self:
+        self.monitor = self.env.monitor
+        self.record_substep, self.end_step = self.monitor.record_substep, self.monitor.end_step
         self.monitor.record_substep, self.monitor.end_step = self._timed_substep, self._timed_end
         return self
 
@@ -181,11 +206,13 @@ class Row:
     off_ms: float
     on_ms: float
     added_ms: float  # median of the paired differences (on - off at the same control step)
+    mean_ratio: float  # sum of the paired differences / sum of the off steps
     substep_ms: float
     end_ms: float
 
     @property
     def ratio(self) -> float:
+        """The median added time over the median off step."""
         return self.added_ms / self.off_ms
 
     @property
@@ -197,13 +224,14 @@ def measure(name: str, off: Any, on: Any, motion: str, steps: int) -> Row:
     """Both envs step in lockstep (the same action at the same control step, so the same
     physical state); the order within a pair alternates, and every other pair the
     monitored env runs with probes on its monitor instead of being timed."""
-    actions = MOTIONS[motion](off, EPISODE)
+    actions = MOTIONS[motion](on, EPISODE)  # the monitored env: the expert reads its records
+    steps = max(steps, len(actions)) if motion == "expert" else steps  # a whole episode at least
     runner_off, runner_on = Runner(off, actions), Runner(on, actions)
     for runner in (runner_off, runner_on):
         runner.env.reset()
         for _ in range(WARMUP):
             runner.step()
-    probe = MonitorProbe(on.monitor)
+    probe = MonitorProbe(on)
     off_ms, on_ms, added = [], [], []
     for i in range(2 * steps):
         if i % 2:  # a probe pair: the monitored env's step is not timed as a whole
@@ -220,24 +248,26 @@ def measure(name: str, off: Any, on: Any, motion: str, steps: int) -> Row:
         on_ms.append(b * 1e3)
         added.append((b - a) * 1e3)
     return Row(name, motion, statistics.median(off_ms), statistics.median(on_ms), statistics.median(added),
-               statistics.median(probe.substep) * 1e3, statistics.median(probe.end) * 1e3)
+               sum(added) / sum(off_ms), statistics.median(probe.substep) * 1e3,
+               statistics.median(probe.end) * 1e3)
 
 
 def table(rows: Sequence[Row]) -> str:
-    head = (f"{'scenario':<26} {'motion':<6} {'off ms':>7} {'on ms':>7} {'added':>7} {'ratio':>7} "
-            f"{'monitor':>8} {'substeps':>9} {'end_step':>9}  vs 15%")
+    head = (f"{'scenario':<26} {'motion':<6} {'off ms':>7} {'on ms':>7} {'added':>7} {'median':>7} "
+            f"{'mean':>7} {'monitor':>8} {'substeps':>9} {'end_step':>9}  mean vs 15%")
     lines = [head, "-" * len(head)]
     for r in rows:
-        mark = "ok" if r.ratio <= TARGET else "OVER"
+        mark = "ok" if r.mean_ratio <= TARGET else "OVER"
         lines.append(f"{r.scenario:<26} {r.motion:<6} {r.off_ms:7.3f} {r.on_ms:7.3f} {r.added_ms:7.3f} "
-                     f"{r.ratio:7.1%} {r.monitor_ms:8.3f} {r.substep_ms:9.3f} {r.end_ms:9.3f}  {mark}")
+                     f"{r.ratio:7.1%} {r.mean_ratio:7.1%} {r.monitor_ms:8.3f} {r.substep_ms:9.3f} "
+                     f"{r.end_ms:9.3f}  {mark}")
     return "\n".join(lines)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--steps", type=int, default=300, help="timed control steps per env, scenario and motion")
-    parser.add_argument("--motions", default="sweep,reach", help="comma-separated: " + ", ".join(MOTIONS))
+    parser.add_argument("--motions", default="sweep,reach,expert", help="comma-separated: " + ", ".join(MOTIONS))
     parser.add_argument("--only", action="append", default=None, help="a scenario name (repeatable)")
     args = parser.parse_args(argv)
     motions = [m for m in args.motions.split(",") if m]
@@ -253,13 +283,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             rows.append(measure(name, off, on, motion, args.steps))
             print(table(rows[-1:]).splitlines()[-1], flush=True)
     print()
-    print("per control step (ms, medians): env step with the monitor off / on, the difference, its ratio")
-    print("to the off step; the monitor's own time = its 25 record_substep calls + end_step")
+    print("per control step (ms, medians): env step with the monitor off / on, the difference; its")
+    print("ratio to the off step as medians and as means (added time / off time over all timed steps);")
+    print("the monitor's own time = its 25 record_substep calls + end_step")
     print(table(rows))
-    worst = max(rows, key=lambda r: r.ratio)
-    over = [r for r in rows if r.ratio > TARGET]
+    worst = max(rows, key=lambda r: r.mean_ratio)
+    over = [r for r in rows if r.mean_ratio > TARGET]
     verdict = "PASS" if not over else f"FAIL ({len(over)} of {len(rows)} over)"
-    print(f"\nverdict: {verdict}: the monitor adds at most {worst.ratio:.1%} "
+    print(f"\nverdict: {verdict}: the monitor adds at most {worst.mean_ratio:.1%} "
           f"({worst.scenario}, {worst.motion}) to a state-only env step; target {TARGET:.0%}"
           f"  [{time.perf_counter() - started:.0f} s]")
     return 0
