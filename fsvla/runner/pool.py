@@ -141,19 +141,23 @@ class ProcessBackend:
     def run(self, specs: Iterable[EpisodeSpec]) -> Iterator[Finished]:
         pending = deque(specs)
         while pending or any(s.state != "idle" for s in self._slots):
-            for slot in self._slots:
-                if slot.state == "idle" and pending:
-                    self._dispatch(slot, pending.popleft())
+            self._hand_out(pending)
             active = [s for s in self._slots if s.state != "idle"]
             if not active:
                 if pending:
                     raise BackendError("no worker process is left to run episodes")
                 break
             wait([s.conn for s in active] + [s.process.sentinel for s in active], POLL_S)
-            for slot in active:
-                finished = self._check(slot, bool(pending))
-                if finished is not None:
-                    yield finished
+            finished = [f for f in (self._check(slot, bool(pending)) for slot in active) if f is not None]
+            # the workers that finished get their next episode before the caller records
+            # these (a trace write and a database commit): they do not wait for the writer
+            self._hand_out(pending)
+            yield from finished
+
+    def _hand_out(self, pending: deque[EpisodeSpec]) -> None:
+        for slot in self._slots:
+            if slot.state == "idle" and pending:
+                self._dispatch(slot, pending.popleft())
 
     # ------------------------------------------------------------------ internals
     def _spawn(self) -> _Slot:
