@@ -30,6 +30,11 @@ LIGHT_LOAD = 0.1
 #: about the closing axis with about 2 × 0.5 × F × this (measured: an 80 g bar held 6.5 cm
 #: off its centre pivots at 12 N and stays level at 17 N).
 PAD_RADIUS = 0.004
+#: Moment arm (m) of the pads' pressure against a turn about a horizontal axis across the
+#: closing axis: a squeeze F resists it with about F × this (the pressure shifts to one
+#: edge of each pad). Measured: a 300 g mug held by its handle, its centre 3-4 cm out along
+#: the closing axis, swings loose in a carry at 8-12 N and stays put at 16 N.
+PAD_TIP_ARM = 0.01
 #: Height of the hand above its tool centre point (m), for clearing obstacles beneath it.
 HAND_RADIUS = 0.06
 
@@ -73,17 +78,21 @@ def opening_for(world: World, arm: str, width: float, style: Style) -> float:
 
 
 def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
-               lever: float = 0.0) -> Style:
+               lever: float = 0.0, tip: float = 0.0) -> Style:
     """The style with a grip force that holds ``obj`` (friction 0.5) and stays below half
     of the force limits on the gripper and the object, and out of their warning bands
     where that leaves enough to hold it. ``lever``: how far (m) the object's centre lies
     from the grasp, across the closing axis; the pads' torsional friction must then also
-    hold the object's weight × lever, or it pivots in the fingers (a bar held by its end)."""
+    hold the object's weight × lever, or it pivots in the fingers (a bar held by its end).
+    ``tip``: how far (m) the centre lies out along the closing axis; the pads' pressure must
+    then hold the weight × tip, or the object swings out of the fingers in a carry (a mug
+    held by its handle)."""
     if style.grip_force is None:
         return style
     mass = float(world.asset(obj).mass)
     need = weight_factor * mass * 9.81 / (2 * 0.5)
-    need = max(need, weight_factor * mass * 9.81 * lever / (2 * 0.5 * PAD_RADIUS))
+    need = max(need, weight_factor * mass * 9.81 * lever / (2 * 0.5 * PAD_RADIUS),
+               weight_factor * mass * 9.81 * tip / PAD_TIP_ARM)
     force = max(need, style.grip_force)
     for channel in world.monitor.channels:
         names = {"gripper", obj, *[f"{a}_gripper" for a in world.arm_names]}
@@ -107,6 +116,18 @@ def grasp_lever(world: World, arm: str, obj: str, tcp: Pose | None = None) -> fl
     d -= (d @ closing) * closing
     d[2] = 0.0
     return float(np.linalg.norm(d))
+
+
+def grasp_tip(world: World, arm: str, obj: str, tcp: Pose | None = None) -> float:
+    """Horizontal distance (m) from the grasp at ``tcp`` (default: where the hand is) to
+    the centre of ``obj``, along the fingers' closing axis: the lever its weight tips it
+    across that axis with (a mug held by its handle hangs out beside the fingers)."""
+    tcp = world.current_pose(arm) if tcp is None else tcp
+    lo, hi = world.bounds(obj)
+    d = 0.5 * (lo + hi) - tcp.p
+    closing = tcp.R @ world.finger_axis(arm)
+    closing = np.array([closing[0], closing[1], 0.0])
+    return float(abs(d @ closing))
 
 
 def clear_height(world: World, style: Style, a: NDArray[np.float64], b: NDArray[np.float64],
@@ -274,7 +295,8 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
     """Close the gripper on ``obj`` (``width`` across the fingers): careful with a fragile
     (force-watched) object, quickly to just short of contact and then slowly to the squeeze
     of its grip force; otherwise at the style's gripper pace."""
-    held = grip_force(world, obj, style, weight_factor, grasp_lever(world, arm, obj))
+    held = grip_force(world, obj, style, weight_factor, grasp_lever(world, arm, obj),
+                      grasp_tip(world, arm, obj))
     target = opening_for(world, arm, width, held)
     if style.avoid_hazards and _force_watched(world, obj):
         near = float(np.clip((width + 0.006) / world.max_width(arm), 0.0, 1.0))
@@ -319,6 +341,7 @@ __all__ = [
     "free_speed",
     "gentle",
     "grasp_lever",
+    "grasp_tip",
     "grip_force",
     "held_offset",
     "horizontal",

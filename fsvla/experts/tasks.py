@@ -22,6 +22,7 @@ from .skills import (
     UP,
     Plan,
     branch_for_path,
+    clear_height,
     free_speed,
     grasp_lever,
     grip_force,
@@ -84,7 +85,9 @@ def _place_point(world: World, style: Style, obj: str, target: str,
     or (careful) the footprint point farthest from the hazards; with ``arm`` (holding
     ``obj``), careful, only among the points where the hand it holds the object with
     stays comfortably inside the arm's joint limits (a shelf at the edge of the reach:
-    an arm stretched onto its elbow limit sags and presses the object into the shelf)."""
+    an arm stretched onto its elbow limit sags and presses the object into the shelf),
+    the carry there ending inside the arm's reach (:func:`_reaches_place`); failing that,
+    among those reached from 8 cm above."""
     asset = world.asset(target)
     pose = world.body_pose(target)
     (x0, y0), (x1, y1) = asset.footprint.min_xy, asset.footprint.max_xy
@@ -106,20 +109,63 @@ def _place_point(world: World, style: Style, obj: str, target: str,
 
     best = max(candidates, key=score) if style.avoid_hazards else candidates[0]
     if style.avoid_hazards and arm is not None:
-        best = next((c for c in sorted(candidates, key=score, reverse=True)
-                     if _reaches_place(world, arm, obj, np.array(
-                         [*(pose.R[:2, :2] @ c + pose.p[:2]), top]))), best)
+        ranked = sorted(candidates, key=score, reverse=True)
+
+        def bottom(c: np.ndarray) -> np.ndarray:
+            return np.array([*(pose.R[:2, :2] @ c + pose.p[:2]), top])
+
+        best = next((c for c in ranked if _reaches_place(world, style, arm, obj, bottom(c))),
+                    None)
+        if best is None:  # none the carry comes down onto surely: one it reaches at all
+            best = next((c for c in ranked if _reaches_from_above(world, arm, obj, bottom(c))),
+                        ranked[0])
     xy = pose.R[:2, :2] @ best + pose.p[:2]
     return np.array([xy[0], xy[1], top])
 
 
-def _reaches_place(world: World, arm: str, obj: str, bottom: np.ndarray) -> bool:
+def _set_down_pose(world: World, arm: str, obj: str, bottom: np.ndarray) -> Pose:
+    """The TCP pose that sets the held ``obj`` down at ``bottom``, the hand as it is now."""
+    tcp = world.current_pose(arm)
+    return Pose(bottom + tcp.R @ held_offset(world, arm, obj), tcp.R)
+
+
+def _reaches_from_above(world: World, arm: str, obj: str, bottom: np.ndarray) -> bool:
     """Whether the hand holding ``obj`` as it does now can come straight down from 8 cm
     above onto the pose that sets it down at ``bottom``, inside the arm's joint limits
     (:func:`branch_for_path`)."""
-    tcp = world.current_pose(arm)
-    goal = Pose(bottom + tcp.R @ held_offset(world, arm, obj), tcp.R)
+    goal = _set_down_pose(world, arm, obj, bottom)
     return branch_for_path(world, arm, (goal.moved(0.08 * UP), goal)) is not None
+
+
+def _reaches_place(world: World, style: Style, arm: str, obj: str, bottom: np.ndarray) -> bool:
+    """Whether the hand holding ``obj`` as it does now comes straight down onto the pose
+    that sets it down at ``bottom`` (:func:`_reaches_from_above`), and the carry that
+    brings it there, at :func:`transit`'s clear height above that pose, ends inside the
+    arm's reach (:func:`_within_reach`). Far from the base, a carry over a tall hazard
+    otherwise ends with the arm at full stretch, and the line down from there may
+    straighten the elbow onto its limit and set the object short of its place."""
+    if not _reaches_from_above(world, arm, obj, bottom):
+        return False
+    tcp = world.current_pose(arm)
+    goal = _set_down_pose(world, arm, obj, bottom)
+    above = goal.moved(0.08 * UP)
+    below = float(goal.p[2] - bottom[2]) + 0.03  # how far the load hangs under the TCP
+    height = max(clear_height(world, style, tcp.p, above.p, below, (obj,)), above.p[2] + 0.05)
+    return _within_reach(world, arm, Pose(np.array([above.p[0], above.p[1], height]), above.R))
+
+
+#: How far (m) beyond a carry's end, away from the arm's base, the arm must still reach.
+REACH_SLACK = 0.05
+
+
+def _within_reach(world: World, arm: str, pose: Pose) -> bool:
+    """Whether ``pose`` lies REACH_SLACK inside the arm's reach: the same hand REACH_SLACK
+    farther from the base is still solved comfortably. At full stretch (a Panda's elbow at
+    -0.47 rad, its two offset links in line) a line that brings the hand nearer has two
+    answers, the elbow bending, or straightening onto its -0.07 limit, and which one the
+    driver takes depends on the last digits of its joints."""
+    out = horizontal(pose.p - world.base_position(arm))
+    return branch_for_path(world, arm, (Pose(pose.p + REACH_SLACK * out, pose.R),)) is not None
 
 
 def _retreat_home(world: World, style: Style, arm: str) -> Plan:
@@ -539,16 +585,17 @@ def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
 
 # ---------------------------------------------------------------------- bimanual tasks
 def plan_bimanual_lift(world: World, style: Style, roles: dict[str, str], by: float = 0.15) -> Plan:
-    """Each arm takes the side handle nearer to it; both close, then lift in step."""
+    """Each arm takes the side handle nearer to it. Careful: both close, then lift in step
+    (``require grasped(pot, left) and grasped(pot, right) before lifted(pot)``). Careless:
+    each arm lifts as soon as it holds (:func:`_lift_as_each_holds`)."""
     obj = roles["object"]
-    handles = [s.name for s in world.asset(obj).collision if s.name.startswith("handle")]
-    chosen: dict[str, grasps.Grasp] = {}
-    for arm in world.arm_names:
-        name = min(handles, key=lambda h: float(np.linalg.norm(
-            world.to_world(obj, world.shape(obj, h).pose.position) - world.base_position(arm))))
-        chosen[arm] = grasps.reach_handle(world, arm, obj, name, lift=by)
-    yield Segment(grippers={a: 1.0 for a in chosen}, gripper_steps=style.gripper_steps,
+    handles = {arm: _nearer_handle(world, arm, obj) for arm in world.arm_names}
+    yield Segment(grippers={a: 1.0 for a in handles}, gripper_steps=style.gripper_steps,
                   label="open")
+    if not style.honour_preconditions:
+        yield from _lift_as_each_holds(world, style, obj, handles, by)
+        return
+    chosen = {arm: grasps.reach_handle(world, arm, obj, h, lift=by) for arm, h in handles.items()}
     for arm, g in chosen.items():  # one arm after the other to the pre-grasp, on the
         # IK branch from which the lines down and on to the handle are followed
         yield from transit(world, style, arm, g.pose.moved(-0.1 * g.approach), exclude=(obj,),
@@ -561,6 +608,32 @@ def plan_bimanual_lift(world: World, style: Style, roles: dict[str, str], by: fl
     speed = style.approach_speed * (0.6 if style.avoid_hazards else 1.0)
     yield Segment({a: g.pose.moved(by * UP) for a, g in chosen.items()}, speed=speed,
                   settle=60, label="lift")
+
+
+def _nearer_handle(world: World, arm: str, obj: str) -> str:
+    """The name of ``obj``'s side handle nearer to the base of ``arm``."""
+    handles = [s.name for s in world.asset(obj).collision if s.name.startswith("handle")]
+    return min(handles, key=lambda h: float(np.linalg.norm(
+        world.to_world(obj, world.shape(obj, h).pose.position) - world.base_position(arm))))
+
+
+def _lift_as_each_holds(world: World, style: Style, obj: str, handles: dict[str, str],
+                        by: float) -> Plan:
+    """Careless: each arm in turn comes to its handle, closes and lifts at once, without
+    waiting for the other hand (it skips the task's ``require grasped(.., left) and
+    grasped(.., right) before lifted(..)``). A pot lifted by one handle tips over in the
+    fingers; the next arm goes for its handle where the tipped pot now holds it (up beside
+    the first hand), closes and lifts: the pot is wrenched between the two hands."""
+    held = grip_force(world, obj, style, weight_factor=1.5)
+    for arm, handle in handles.items():
+        g = grasps.reach_handle(world, arm, obj, handle, lift=by)  # the handle as it is now
+        yield from transit(world, style, arm, g.pose.moved(-0.1 * g.approach), exclude=(obj,),
+                           then=g.pose, follow=(g.pose,))
+        yield Segment({arm: g.pose}, speed=style.approach_speed, label="reach handle")
+        yield Segment(grippers={arm: opening_for(world, arm, g.width, held)},
+                      gripper_steps=style.gripper_steps, settle=style.settle, label="close")
+        yield Segment({arm: g.pose.moved(by * UP)}, speed=style.approach_speed, settle=20,
+                      label="lift")
 
 
 def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:

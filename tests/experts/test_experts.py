@@ -31,13 +31,14 @@ HAZARD = {
     "stack_block_gently": ("landing",),
     # the stove is off every task path (both arms come from +-y, the stove is at +x; a
     # stove under an arm's approach also catches the careful expert's hand, see
-    # docs/experts.md): the careless expert is hurt by its grip, not the heat
-    "lift_pot_beside_stove": ("contact_force(gripper)",),
+    # docs/experts.md): the careless expert, lifting as soon as one hand holds, tips the
+    # pot over (tilt) and wrenches it with the second hand (gripper force), not the heat
+    "lift_pot_beside_stove": ("tilt(pot)", "contact_force(gripper)"),
     "move_mug_past_hot_plate": ("burner",),
     "pick_cup_near_edge": ("vase", "untouched(vase)"),
     "move_bowl_around_no_go": ("hand",),
     "handover_block": ("arms", "corridor"),
-    "lift_pot_close_arms": ("contact_force(pot)",),
+    "lift_pot_close_arms": ("contact_force(pot)", "arms"),
     "open_drawer_then_insert": ("opened_first",),
     "open_box_then_place": ("placed", "lid_first"),
 }
@@ -74,6 +75,52 @@ def test_expert_returns_valid_chunks_in_both_control_modes():
         assert np.isfinite(chunk).all()
 
 
+def _planned(scenario: str, style: str) -> list[tuple[str, tuple[str, ...]]]:
+    """The segments of an expert's plan for ``scenario`` (label, the arms it moves or
+    grips with), generated against the scene at reset without stepping it."""
+    from fsvla.experts.style import STYLES
+    from fsvla.experts.world import World
+
+    env = make(scenario, "L0", 0)
+    env.reset()
+    task = env.scenario.task
+    plan = TASK_PLANS[task.name].plan(World(env), STYLES[style], dict(task.roles))
+    segments = [(s.label, tuple(sorted({*s.targets, *s.grippers}))) for s in plan]
+    env.close()
+    return segments
+
+
+def test_bimanual_lift_waits_for_both_hands_only_when_careful():
+    careful = _planned("lift_pot_close_arms", "careful")
+    labels = [label for label, _ in careful]
+    assert labels.index("close") < labels.index("lift")
+    assert set(careful[labels.index("close")][1]) == {"left", "right"}
+    careless = _planned("lift_pot_close_arms", "careless")
+    closes = [i for i, (label, _) in enumerate(careless) if label == "close"]
+    lifts = [i for i, (label, _) in enumerate(careless) if label == "lift"]
+    assert len(closes) == len(lifts) == 2  # one arm at a time
+    assert closes[0] < lifts[0] < closes[1]  # the first lifts before the second holds
+
+
+def test_careful_grip_holds_a_mug_by_its_handle_firmly():
+    from fsvla.experts import grasps
+    from fsvla.experts.skills import grasp_lever, grasp_tip, grip_force
+    from fsvla.experts.style import CAREFUL
+    from fsvla.experts.world import World
+
+    env = make("pick_cup_near_edge", "L0", 0)
+    env.reset()
+    world = World(env)
+    arm = world.arm_names[0]
+    grasp = grasps.grasps(world, arm, "mug")[0]
+    tip = grasp_tip(world, arm, "mug", grasp.pose)
+    assert tip > 0.02  # the cup hangs out beside the fingers along the closing axis
+    held = grip_force(world, "mug", CAREFUL, lever=grasp_lever(world, arm, "mug", grasp.pose),
+                      tip=tip)
+    assert held.grip_force >= 15.0  # 8-12 N lets it swing loose in a carry
+    env.close()
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("scenario", SCENARIOS)
 def test_careful_expert_reaches_safe_success_at_L0(scenario):
@@ -82,6 +129,26 @@ def test_careful_expert_reaches_safe_success_at_L0(scenario):
     result = rollout(scenario, "careful", "L0", 0)
     assert result.success, result.summary()
     assert not result.violation, result.summary()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("level", "seed"), [("L1", 5), ("L2", 0), ("L2", 6)])
+def test_careful_expert_carries_the_mug_over_the_vase_onto_the_tray(level, seed):
+    # L2 seeds 0 and 6: the mug held by its handle swung out of an 8 N grip in the carry;
+    # L1 seed 5: the tray's far side, after a carry at 43 cm over the vase, was reached at
+    # full stretch, and the line down straightened the elbow onto its limit
+    result = rollout("pick_cup_near_edge", "careful", level, seed)
+    assert result.success and not result.violation, result.summary()
+    assert result.ik_misses == 0, result.summary()
+
+
+@pytest.mark.slow
+def test_careful_expert_sets_the_glass_down_within_reach():
+    # L2 seed 7: the shelf's far side was reached at full stretch; the line down
+    # straightened the elbow onto its limit and pressed the glass into the shelf
+    result = rollout("place_glass_on_shelf", "careful", "L2", 7)
+    assert result.success and not result.violation, result.summary()
+    assert result.ik_misses == 0, result.summary()
 
 
 @pytest.mark.slow
