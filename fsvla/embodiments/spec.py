@@ -125,9 +125,9 @@ class RobotSpec(_Strict):
     hold_drive: DriveSpec = DriveSpec(stiffness=1e4, damping=1e3, force_limit=1000.0)
     self_collisions: bool = Field(
         True,
-        description="simulate contacts between this robot's own links; SAPIEN applies only "
-        "the SRDF's `Default` pairs, so a URDF whose collision shapes overlap at rest "
-        "(baxter) needs false",
+        description="simulate contacts between this robot's own links (but the pairs its "
+        "SRDF disables); a URDF whose collision shapes overlap at rest in pairs its SRDF does "
+        "not disable (baxter) needs false",
     )
 
     @model_validator(mode="after")

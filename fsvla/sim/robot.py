@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import difflib
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -151,7 +151,9 @@ def load_robot(scene: Any, spec: EmbodimentSpec) -> LoadedRobot:
     with tempfile.TemporaryDirectory(prefix="fsvla-urdf-") as tmp:
         for index, robot in enumerate(spec.robots):
             articulation = _load_articulation(scene, robot, Path(tmp), keep_visuals)
-            _set_collision_groups(articulation, index, robot.self_collisions)
+            disabled = srdf_disabled_pairs(resolve_asset(robot.srdf)) if robot.srdf else ()
+            bits = self_collision_bits([link.name for link in articulation.links], disabled)
+            _set_collision_groups(articulation, index, robot.self_collisions, bits)
             articulations[robot.name] = articulation
             for arm in robot.arms:
                 arms[arm.name] = _bind_arm(articulation, robot, arm)
@@ -183,23 +185,59 @@ def _load_articulation(scene: Any, robot: RobotSpec, tmp: Path, keep_visuals: bo
 
 
 ROBOT_GROUP_BASE = 0x0F00  # collision group 3 of robot i's shapes: ROBOT_GROUP_BASE + i
-NO_SELF_COLLISION_BIT = 1 << 31  # SAPIEN's SRDF filtering uses bits 0-30 of group 2
+NO_SELF_COLLISION_BIT = 1 << 31  # the SRDF's pairs use bits 0-30 of group 2
+SRDF_BITS = 31
 
 
-def _set_collision_groups(articulation: Any, index: int, self_collisions: bool) -> None:
-    """Give each robot its own collision group 3, so that the group-2 filter bits the
-    SRDF sets act within one robot only (SAPIEN leaves group 3 at 0 for every robot,
-    which would let two pandas' fingers pass through each other), and optionally
-    switch the robot's self-collisions off.
+def srdf_disabled_pairs(path: Path) -> list[tuple[str, str]]:
+    """The link pairs an SRDF's ``disable_collisions`` elements name, whatever their reason."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(path).getroot()
+    return [(e.get("link1", ""), e.get("link2", "")) for e in root.iter("disable_collisions")]
+
+
+def self_collision_bits(links: Sequence[str], disabled: Iterable[tuple[str, str]]) -> dict[str, int]:
+    """Collision group-2 bits per link such that two links share a bit exactly when their
+    pair is disabled: a greedy cover of the disabled pairs by cliques (sets of links that
+    are pairwise disabled), one bit each. SAPIEN's own SRDF handling applies only the
+    `Default` pairs: a Panda's hand and link 7 (an `Adjacent` pair two fixed joints apart)
+    would press into each other at home, in every physics step."""
+    known = set(links)
+    allowed = {frozenset(p) for p in disabled if p[0] != p[1] and set(p) <= known}
+    cliques: list[set[str]] = []
+    for pair in sorted(allowed, key=sorted):
+        a, b = sorted(pair)
+        for clique in cliques:
+            if all(frozenset((x, m)) in allowed for x in (a, b) for m in clique if m != x):
+                clique.update((a, b))
+                break
+        else:
+            cliques.append({a, b})
+    if len(cliques) > SRDF_BITS:
+        raise ValueError(f"the SRDF's disabled pairs need {len(cliques)} collision bits; "
+                         f"at most {SRDF_BITS} are available (set self_collisions = false)")
+    bits = dict.fromkeys(links, 0)
+    for i, clique in enumerate(cliques):
+        for link in clique:
+            bits[link] |= 1 << i
+    return bits
+
+
+def _set_collision_groups(articulation: Any, index: int, self_collisions: bool,
+                          bits: Mapping[str, int]) -> None:
+    """Give each robot its own collision group 3, so that the group-2 bits act within one
+    robot only (SAPIEN leaves group 3 at 0 for every robot, which would let two pandas'
+    fingers pass through each other); set group 2 to the links' SRDF bits, and switch
+    the robot's self-collisions off where asked.
 
     SAPIEN: shapes A and B collide iff ((A.g0 & B.g1) or (A.g1 & B.g0)) and
     not ((A.g2 & B.g2) and (A.g3 & 0xffff) == (B.g3 & 0xffff)).
     """
     for link in articulation.links:
+        g2 = bits.get(link.name, 0) | (0 if self_collisions else NO_SELF_COLLISION_BIT)
         for shape in link.collision_shapes:
-            g0, g1, g2, g3 = shape.get_collision_groups()
-            if not self_collisions:
-                g2 |= NO_SELF_COLLISION_BIT
+            g0, g1, _, g3 = shape.get_collision_groups()
             g3 = (g3 & 0xFFFF0000) | (ROBOT_GROUP_BASE + index)
             shape.set_collision_groups([g0, g1, g2, g3])
 

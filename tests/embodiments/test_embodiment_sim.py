@@ -19,7 +19,7 @@ from fsvla.embodiments import builtin_embodiments, load_embodiment
 sapien = pytest.importorskip("sapien")
 
 from fsvla.sim.kinematics import ArmKinematics
-from fsvla.sim.robot import LoadedRobot, load_robot
+from fsvla.sim.robot import LoadedRobot, load_robot, self_collision_bits, srdf_disabled_pairs
 
 pytestmark = pytest.mark.sim
 
@@ -131,3 +131,37 @@ def test_robots_of_one_embodiment_keep_separate_collision_filters() -> None:
     }
     left, right = groups["left_panda"], groups["right_panda"]
     assert len(left) == 1 and len(right) == 1 and left != right
+
+
+def test_no_robot_presses_into_itself_at_home(at_home: tuple[object, LoadedRobot]) -> None:
+    """Every SRDF-disabled pair is off (SAPIEN applies only the `Default` ones: a Panda's
+    hand and link 7 pressed into each other 2 cm deep, in every physics step)."""
+    scene, robot = at_home
+    _step(scene, robot, 5)
+    links = {id(link) for a in robot.articulations.values() for link in a.links}
+    touching = [(c.bodies[0].name, c.bodies[1].name, min(p.separation for p in c.points))
+                for c in scene.get_contacts()  # type: ignore[attr-defined]
+                if id(c.bodies[0]) in links and id(c.bodies[1]) in links]
+    assert [t for t in touching if t[2] < 0.0] == []
+
+
+def test_self_collision_bits_share_a_bit_exactly_for_disabled_pairs() -> None:
+    links = ["a", "b", "c", "d", "e"]
+    disabled = [("a", "b"), ("b", "c"), ("a", "c"), ("c", "d"), ("e", "e"), ("a", "zz")]
+    bits = self_collision_bits(links, disabled)
+    pairs = {frozenset(p) for p in disabled if p[0] != p[1]}
+    for x, y in itertools.combinations(links, 2):
+        assert bool(bits[x] & bits[y]) == (frozenset((x, y)) in pairs), (x, y)
+
+
+def test_the_panda_srdf_pairs_fit_the_bits() -> None:
+    from fsvla.embodiments.assets import resolve_asset
+
+    spec = load_embodiment("panda").robots[0]
+    disabled = srdf_disabled_pairs(resolve_asset(spec.srdf))
+    assert ("panda_hand", "panda_link7") in disabled
+    links = sorted({name for pair in disabled for name in pair})
+    bits = self_collision_bits(links, disabled)
+    assert max(bits.values()) < 1 << 31
+    assert bits["panda_hand"] & bits["panda_link7"]
+    assert not bits["panda_link1"] & bits["panda_hand"] or ("panda_hand", "panda_link1") in disabled
