@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from .state import ContactMaxima, PoseMap, WorldState, link_frame, robot_frame
+from .state import ContactMaxima, PoseMap, WorldState, link_frame, pair_key, robot_frame
 
 #: The "other side" of a body's net contact force in ContactMaxima keys.
 NET = "*"
@@ -278,8 +278,12 @@ class Probe:
         return {c for f, c in self.components.items() if f in frames}
 
     def _scan(self, inv_dt: float) -> list[tuple[str, str, str, float]]:
-        """Fold the wanted contacts into the maxima; returns what it folded in."""
-        maxima, cache, hot, records = self.maxima, self._scan_pairs, self._scan_hot, []
+        """Fold the wanted contacts into the maxima; returns what it folded in. A frame
+        pair's force is the sum over its contacts (one per pair of collision shapes: a
+        finger on a glass of 16 wall pieces touches several), as its torque is."""
+        cache, hot = self._scan_pairs, self._scan_hot
+        forces: dict[tuple[str, str], list[float]] = {}  # pair_key (a, b): impulse on a by b
+        torques: dict[tuple[str, str], list[float]] = {}  # (frame, other): angular impulse on frame
         centres: dict[int, tuple[float, float, float]] = {}  # torque bodies' mass centres, this substep
         for contact in self._contacts():
             b0, b1 = contact.bodies
@@ -289,41 +293,51 @@ class Probe:
                 plan = cache[key] = self._scan_plan(b0, b1) if b0 in hot or b1 in hot else None
             if plan is None:
                 continue
-            f0, f1, torque0, torque1 = plan
+            pair, sign, torque0, torque1 = plan
             points = contact.points
-            if not (torque0 or torque1):
-                x, y, z = _impulse(points)
-                magnitude = math.sqrt(x * x + y * y + z * z) * inv_dt
-                if magnitude > 0.0:
-                    maxima.add_force(f0, f1, magnitude)
-                    records.append(("f", f0, f1, magnitude))
-                continue
             impulses = [p.impulse.tolist() for p in points]
-            positions = [p.position.tolist() for p in points]
-            x = y = z = 0.0
-            for a, b, c in impulses:
-                x, y, z = x + a, y + b, z + c
-            magnitude = math.sqrt(x * x + y * y + z * z) * inv_dt
-            if magnitude <= 0.0:
-                continue
-            maxima.add_force(f0, f1, magnitude)
-            records.append(("f", f0, f1, magnitude))
-            for torque, body, frame, other in ((torque0, b0, f0, f1), (torque1, b1, f1, f0)):
-                if torque:
-                    centre = centres.get(id(body))
-                    if centre is None:
-                        centre = centres[id(body)] = _mass_centre(body)
-                    value = _torque(impulses, positions, centre) * inv_dt
-                    maxima.add_torque(frame, other, value)
-                    records.append(("t", frame, other, value))
+            total = forces.get(pair)
+            if total is None:
+                total = forces[pair] = [0.0, 0.0, 0.0]
+            for x, y, z in impulses:
+                total[0] += sign * x
+                total[1] += sign * y
+                total[2] += sign * z
+            if torque0 or torque1:
+                positions = [p.position.tolist() for p in points]
+                f0, f1 = pair if sign > 0 else pair[::-1]
+                for wanted, body, frame, other, on in ((torque0, b0, f0, f1, 1.0), (torque1, b1, f1, f0, -1.0)):
+                    if wanted:
+                        centre = centres.get(id(body))
+                        if centre is None:
+                            centre = centres[id(body)] = _mass_centre(body)
+                        moment = torques.get((frame, other))
+                        if moment is None:
+                            moment = torques[(frame, other)] = [0.0, 0.0, 0.0]
+                        _add_moment(moment, impulses, positions, centre, on)
+        return self._fold(forces, torques, inv_dt)
+
+    def _fold(self, forces: dict[tuple[str, str], list[float]], torques: dict[tuple[str, str], list[float]],
+              inv_dt: float) -> list[tuple[str, str, str, float]]:
+        """Fold a substep's per-pair impulses into the maxima as forces; what it folded in."""
+        maxima, records = self.maxima, []
+        for kind, totals, add in (("f", forces, maxima.add_force), ("t", torques, maxima.add_torque)):
+            for (a, b), (x, y, z) in totals.items():
+                value = math.sqrt(x * x + y * y + z * z) * inv_dt
+                if value > 0.0:
+                    add(a, b, value)
+                    records.append((kind, a, b, value))
         return records
 
-    def _scan_plan(self, b0: Any, b1: Any) -> tuple[str, str, bool, bool] | None:
-        """(frame 0, frame 1, torque on 0, torque on 1) of a contact pair the scan keeps."""
+    def _scan_plan(self, b0: Any, b1: Any) -> tuple[tuple[str, str], float, bool, bool] | None:
+        """(pair_key of the frames, +1 if the contact's first body is the key's first frame
+        else -1, torque on body 0, torque on body 1) of a contact pair the scan keeps."""
         frames = self._pair(b0, b1, self._filter.wants)
         if frames is None:
             return None
-        return frames[0], frames[1], frames[0] in self._torque, frames[1] in self._torque
+        f0, f1 = frames
+        pair = pair_key(f0, f1)
+        return pair, 1.0 if pair[0] == f0 else -1.0, f0 in self._torque, f1 in self._torque
 
     def _contacts(self) -> list[Any]:
         return self._physx.get_contacts()
@@ -424,18 +438,15 @@ def _mass_centre(body: Any) -> tuple[float, float, float]:
     return tuple((body.entity_pose * body.cmass_local_pose).p.tolist())
 
 
-def _torque(impulses: list[list[float]], positions: list[list[float]],
-            centre: tuple[float, float, float]) -> float:
-    """Magnitude of the torque of impulses at positions about ``centre`` (the same for
-    both bodies of a contact: their impulses are opposite)."""
+def _add_moment(moment: list[float], impulses: list[list[float]], positions: list[list[float]],
+                centre: tuple[float, float, float], sign: float) -> None:
+    """Add the moment about ``centre`` of ``sign`` × the impulses at their positions."""
     cx, cy, cz = centre
-    tx = ty = tz = 0.0
     for (ix, iy, iz), (px, py, pz) in zip(impulses, positions):
         rx, ry, rz = px - cx, py - cy, pz - cz
-        tx += ry * iz - rz * iy
-        ty += rz * ix - rx * iz
-        tz += rx * iy - ry * ix
-    return math.sqrt(tx * tx + ty * ty + tz * tz)
+        moment[0] += sign * (ry * iz - rz * iy)
+        moment[1] += sign * (rz * ix - rx * iz)
+        moment[2] += sign * (rx * iy - ry * ix)
 
 
 __all__ = ["NET", "ContactFilter", "Probe", "components_of"]

@@ -83,6 +83,32 @@ def test_net_and_pair_forces_agree_on_a_resting_box():
     assert s.contact_torque[("box", NET)] < 1e-3
 
 
+def test_a_pair_force_sums_the_contacts_of_every_shape_pair():
+    """A box of two halves resting on the ground: two contacts, one per half, and the
+    pair's force is their sum (the weight), as the net force says, not the larger half."""
+    scene, _, _, ground = _scene()
+    builder = scene.create_actor_builder()
+    for y in (-0.025, 0.025):
+        builder.add_box_collision(pose=sapien.Pose([0, y, 0]), half_size=[0.05, 0.025, 0.05], density=1000.0)
+    halves = builder.build(name="halves")
+    halves.set_pose(sapien.Pose([0.3, 0, 0.05]))
+    rigid = halves.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent)
+    for _ in range(50):
+        scene.step()
+    probe = Probe(scene, DT, {"halves": rigid, "ground": ground}, free_bodies=["halves"],
+                  torque_frames=["halves"], scan=ContactFilter(any_pair=frozenset({"ground"})))
+    probe.reset()
+    for _ in range(5):
+        scene.step()
+        probe.record_substep()
+    s = probe.snapshot(1, 0.01)
+    weight = rigid.mass * 9.81
+    assert sum(1 for c in scene.get_contacts() if halves in [b.entity for b in c.bodies]) == 2
+    assert s.contact_force[pair_key("halves", "ground")] == pytest.approx(weight, rel=0.02)
+    assert s.contact_force[pair_key("halves", NET)] == pytest.approx(weight, rel=0.02)
+    assert s.contact_torque[("halves", "ground")] < 0.05 * weight * 0.05  # balanced about the centre
+
+
 def test_sapien_capsules_lie_along_x():
     scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
     builder = scene.create_actor_builder()
