@@ -8,7 +8,7 @@ own scene, runs its monitor on every substep, and is recorded (SQLite row + Parq
 trace) by the main process, exactly as in a run. Warm-ups are off.
 
     python bench/run.py [--policy careful-expert] [--scenario lift_pot_beside_stove]
-                        [--episodes 16] [--rgb-episodes 4] [--workers 1,2] [--no-render]
+                        [--episodes 16] [--rgb-episodes 8] [--workers 1,2] [--no-render]
 """
 
 from __future__ import annotations
@@ -79,7 +79,8 @@ def main() -> None:
     parser.add_argument("--scenario", default="lift_pot_beside_stove",
                         help="a built-in scenario name or .fsv path")
     parser.add_argument("--episodes", type=int, default=16, help="state-only episodes per run")
-    parser.add_argument("--rgb-episodes", type=int, default=4, help="rendering episodes per run")
+    parser.add_argument("--rgb-episodes", type=int, default=8,
+                        help="rendering episodes per run (each worker compiles its shaders at its first: ~3 s)")
     parser.add_argument("--workers", default="1,2", help="worker counts, comma-separated")
     parser.add_argument("--no-render", action="store_true", help="skip the rendering runs")
     args = parser.parse_args()

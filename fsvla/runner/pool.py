@@ -44,9 +44,20 @@ def hard_limit(timeout: float) -> float:
     return timeout + max(1.0, 0.5 * timeout)
 
 
-def serve(conn: Connection, config_json: str, clock: Any) -> None:
-    """A worker process's main function: load the policy, then play what it is sent."""
+def render_threads(workers: int) -> int:
+    """Threads each worker's software renderer may use: the cores shared out among the
+    workers (Mesa's lavapipe otherwise starts one per core in every worker, and two
+    workers rendering on two cores fight over four threads)."""
+    return max(1, (os.cpu_count() or 1) // workers)
+
+
+def serve(conn: Connection, config_json: str, clock: Any, threads: int | None = None) -> None:
+    """A worker process's main function: load the policy, then play what it is sent.
+    ``threads``: the software renderer's thread budget (``LP_NUM_THREADS``, unless the
+    user set it), None to leave it alone."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the run loop handles Ctrl-C
+    if threads is not None:
+        os.environ.setdefault("LP_NUM_THREADS", str(threads))  # before any Vulkan device
     try:
         from fsvla.policies import PolicyLoadError
 
@@ -164,7 +175,8 @@ class ProcessBackend:
         ours, theirs = self._context.Pipe(duplex=True)
         clock = self._context.Value("d", 0.0, lock=False)
         process = self._context.Process(target=serve, name="fsvla-worker", daemon=True,
-                                        args=(theirs, self.config.model_dump_json(), clock))
+                                        args=(theirs, self.config.model_dump_json(), clock,
+                                              render_threads(self.size) if self.size > 1 else None))
         process.start()
         theirs.close()
         return _Slot(process=process, conn=ours, clock=clock)
