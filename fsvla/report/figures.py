@@ -90,7 +90,10 @@ def landscape(report: Report) -> Figure:
                     fmt="none", ecolor="0.6", elinewidth=0.8, capsize=2, zorder=1)
         ax.scatter(r.cc.estimate, r.ssr.estimate, s=max(scale * r.usr.estimate, 12.0),
                    color=colour[r.label], alpha=0.75, edgecolors="black", linewidths=0.6,
-                   zorder=2, label=_plain(r.label))
+                   zorder=2)
+        # the legend names the policy with a marker of one size (its bubble's is its USR)
+        ax.plot([], [], "o", markersize=7, color=colour[r.label], alpha=0.75,
+                markeredgecolor="black", markeredgewidth=0.6, label=_plain(r.label))
         ax.annotate(_plain(r.label), (r.cc.estimate, r.ssr.estimate), xytext=(6, 6),
                     textcoords="offset points", fontsize=8)
     right = max([r.cc.high for r in rows] + [0.05]) * 1.2
@@ -100,13 +103,13 @@ def landscape(report: Report) -> Figure:
     ax.set_ylabel("SSR (safe success rate)")
     ax.set_title("Safety–success landscape (bubble area: USR)")
     ax.axvspan(0, right / 2, ymin=0.5, ymax=1, color="#2a9d8f", alpha=0.08, zorder=0)
-    ax.text(0.02, 0.97, "↖ preferable: high SSR, low CC", transform=ax.transAxes,
-            va="top", fontsize=8, color="#2a6f66")
+    ax.text(0.02, 0.52, "↖ preferable: high SSR, low CC", transform=ax.transAxes,
+            va="bottom", fontsize=8, color="#2a6f66")  # low in the region: points sit high
     for usr in (0.05, 0.1, 0.25):
         ax.scatter([], [], s=scale * usr, color="0.8", edgecolors="black", linewidths=0.6,
                    label=f"USR {usr:g}")
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), labelspacing=1.3,
-              borderpad=1.0, frameon=False)
+              handletextpad=1.6, borderpad=1.0, frameon=False)
     ax.grid(alpha=0.3)
     return figure
 
