@@ -13,7 +13,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from fsvla.compiler.monitor import MonitorSpec
 from fsvla.compiler.scene import SceneSpec

@@ -339,9 +339,8 @@ class SceneGeometry:
             rows_b += [y for _ in fa for y in fb]
         if not keys:
             return ((), None, None, None, None, None)
-        as_index = lambda v: np.array(v, dtype=np.int64)  # noqa: E731
-        return (tuple(keys), np.concatenate(frames), as_index(frame_starts), as_index(rows_a),
-                as_index(rows_b), as_index(starts))
+        return (tuple(keys), np.concatenate(frames), *(np.array(v, dtype=np.int64)
+                                                       for v in (frame_starts, rows_a, rows_b, starts)))
 
     def distance(self, a: frozenset[str], b: frozenset[str], exact_below: float = MAX_DISTANCE) -> float:
         """Smallest signed distance between the pieces of two frame groups (negative when

@@ -64,10 +64,8 @@ def update_bounds(poses: NDArray[np.float64], piece_frame: NDArray[np.int64],
                 h += abs(m) * half[p, j]
             lo, hi = c - h, c + h
             plo[p, i], phi[p, i] = lo, hi
-            if lo < flo[r, i]:
-                flo[r, i] = lo
-            if hi > fhi[r, i]:
-                fhi[r, i] = hi
+            flo[r, i] = min(flo[r, i], lo)
+            fhi[r, i] = max(fhi[r, i], hi)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -98,9 +96,7 @@ def nearest_per_query(lo: NDArray[np.float64], hi: NDArray[np.float64], a: NDArr
         end = starts[q + 1] if q + 1 < n else a.shape[0]
         best = np.inf
         for k in range(starts[q], end):
-            d = _distance(lo, hi, a[k], b[k])
-            if d < best:
-                best = d
+            best = min(best, _distance(lo, hi, a[k], b[k]))
         out[q] = best
 
 

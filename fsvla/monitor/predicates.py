@@ -27,7 +27,7 @@ pressed    the grippers push the object down (force z < -PRESS_FORCE) in the las
 from __future__ import annotations
 
 from collections.abc import Callable
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -121,7 +121,7 @@ def _param(p: Predicate, name: str) -> float:
     return _default(p.name, name) if value is None else float(value)  # type: ignore[arg-type]
 
 
-@lru_cache(maxsize=None)
+@cache
 def _default(predicate: str, name: str) -> float:
     return float(PREDICATES[predicate].param(name).default)  # type: ignore[union-attr, arg-type]
 
