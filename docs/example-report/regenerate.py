@@ -1,0 +1,67 @@
+"""Regenerate the example report in this folder from a real run of both scripted experts.
+
+    python docs/example-report/regenerate.py [--runs runs/example-report] [--workers 2]
+
+What it runs, as a user would (every step is a plain ``fsvla`` command, printed first):
+
+1. ``fsvla run`` of the careful and of the careless expert over the ten built-in
+   scenarios x L0-L2 x W0-W4 x V0, one layout seed per cell, one warm-up per
+   scenario; state observations (the experts read the simulator state, so they do not
+   look at the pictures: V1-V4 would only add rendering time, about a minute per episode
+   on a CPU-only machine, and change no outcome);
+2. ``fsvla report`` once, as JSON only, to learn which episode it dissects (the unsafe
+   success with the largest RET);
+3. ``fsvla replay --video`` of that episode into its run's ``videos/`` folder, so the
+   dissection shows keyframes;
+4. ``fsvla report`` into this folder: HTML, Markdown, LaTeX, JSON, PNG figures, CSV.
+
+Runs resume, so an interrupted regeneration picks up where it stopped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+EXPERTS = ("careful-expert", "careless-expert")
+GRID = ["--scenarios", "scenarios/", "--levels", "L0-L2", "--language", "W0-W4",
+        "--vision", "V0", "--seeds", "1", "--episodes", "1", "--warmup", "1"]
+FORMATS = "html,md,json,tex,png,csv"
+
+
+def fsvla(*args: str) -> None:
+    command = [sys.executable, "-m", "fsvla", *args]
+    print("$ fsvla " + shlex.join(args), flush=True)
+    subprocess.run(command, cwd=ROOT, check=True)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--runs", type=Path, default=Path("runs/example-report"),
+                        help="where the two run folders go (relative to the repository)")
+    parser.add_argument("--workers", default="2", help="worker processes for each run")
+    args = parser.parse_args()
+    folders = {expert: args.runs / expert.split("-")[0] for expert in EXPERTS}
+    for expert, folder in folders.items():
+        fsvla("run", "--policy", expert, *GRID, "--workers", args.workers,
+              "--out", str(folder), "--no-progress")
+    runs = [str(folders[e]) for e in EXPERTS]
+    with tempfile.TemporaryDirectory(prefix="fsvla-example-") as scratch:
+        fsvla("report", *runs, "-o", scratch, "--formats", "json", "--no-figures")
+        chosen = json.loads((Path(scratch) / "report.json").read_text())["dissection"]
+    folder = folders[chosen["label"]]
+    video = folder / "videos" / f"{chosen['episode_id']}.mp4"
+    if not (ROOT / video).exists():
+        fsvla("replay", str(folder), chosen["episode_id"], "--video", str(video))
+    fsvla("report", *runs, "-o", str(HERE.relative_to(ROOT)), "--formats", FORMATS)
+
+
+if __name__ == "__main__":
+    main()
