@@ -70,7 +70,7 @@ class ScenarioLoader:
         if sink.has_errors:
             return LoadResult(display, None, sink.sorted(), decl.abstract, sources)
         merged = merge([c for _, c in chain], sink)
-        digest = hashlib.sha256("\0".join(sources[self.display(p)] for p, _ in chain).encode()).hexdigest()
+        digest = source_digest("\0".join(sources[self.display(p)] for p, _ in chain))
         lineage = tuple(self.display(p) for p, _ in reversed(chain[:-1]))
         checker = ScenarioChecker(decl, merged, sink, self._path_resolver(path, roots, sink),
                                   lineage, digest)
@@ -93,7 +93,7 @@ class ScenarioLoader:
             chain = self._chain(base / name, decl, roots, sink, sources)
         merged = merge([c for _, c in chain], sink)
         checker = ScenarioChecker(decl, merged, sink, self._path_resolver(base / name, roots, sink),
-                                  (), hashlib.sha256(text.encode()).hexdigest())
+                                  (), source_digest(text))
         return LoadResult(name, checker.check(), sink.sorted(), decl.abstract, sources)
 
     def display(self, path: Path) -> str:
@@ -205,6 +205,12 @@ class ScenarioLoader:
                 return None
             return str(candidate)
         return resolve
+
+
+def source_digest(text: str) -> str:
+    """SHA-256 of a scenario's text. A string given to ``loads`` may hold lone surrogates
+    (a file never does: it is decoded strictly), which plain UTF-8 cannot encode."""
+    return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
 
 
 def _with_overflow_note(sink: DiagnosticSink) -> list[Diagnostic]:

@@ -129,3 +129,10 @@ def test_any_backslash_escape_in_a_string(escape: str) -> None:
     text = f'scenario s\n  instruction "a{escape}b"\n  extends_me_not x\n'
     _run(text)
     _run(f'scenario s extends "x{escape}.fsv"\n  suite force\n')
+
+
+def test_a_lone_surrogate_in_a_string_gives_a_result() -> None:
+    """A str given to loads() may hold a lone surrogate (hypothesis found one in a comment)."""
+    text = "#\ud800 " + TEXTS[0]
+    _run(text)
+    _run(TEXTS[0].replace("pot", "p\ud800t", 1))
