@@ -185,8 +185,9 @@ class Probe:
         self._last = last
         self._joints = dict(joints or {})  # "<body>:<joint>" -> (articulation, qpos index)
         self.maxima = ContactMaxima()
-        # (id(body0), id(body1)) -> their frames if the scan keeps the pair, else None; the
-        # bodies are the components above and the scene's other bodies, alive as long as it
+        # (id(body0), id(body1)) -> the scan's plan for the pair if it keeps it (_scan_plan),
+        # or the last-substep reading's frames, else None; the bodies are the components
+        # above and the scene's other bodies, alive as long as it
         self._scan_pairs: dict[tuple[int, int], tuple[str, str, bool, bool] | None] = {}
         self._last_pairs: dict[tuple[int, int], tuple[str, str] | None] = {}
         self._scan_hot, self._last_hot = self._hot(scan), self._hot(last)
@@ -319,7 +320,8 @@ class Probe:
 
     def _fold(self, forces: dict[tuple[str, str], list[float]], torques: dict[tuple[str, str], list[float]],
               inv_dt: float) -> list[tuple[str, str, str, float]]:
-        """Fold a substep's per-pair impulses into the maxima as forces; what it folded in."""
+        """Fold a substep's per-pair impulses and angular impulses into the maxima, as
+        forces and torques; returns what it folded in."""
         maxima, records = self.maxima, []
         for kind, totals, add in (("f", forces, maxima.add_force), ("t", torques, maxima.add_torque)):
             for (a, b), (x, y, z) in totals.items():
@@ -367,10 +369,10 @@ class Probe:
                 continue
             f0, f1 = frames
             x, y, z = _impulse(contact.points)
-            for key, sign in (((f0, f1), inv_dt), ((f1, f0), -inv_dt)):
-                total = totals.get(key)
+            for ordered, sign in (((f0, f1), inv_dt), ((f1, f0), -inv_dt)):
+                total = totals.get(ordered)
                 if total is None:
-                    total = totals[key] = [0.0, 0.0, 0.0]
+                    total = totals[ordered] = [0.0, 0.0, 0.0]
                 total[0] += sign * x
                 total[1] += sign * y
                 total[2] += sign * z
