@@ -164,3 +164,30 @@ def test_every_builtin_scenario_is_rolled_out():
 
     assert set(SCENARIOS) == set(builtin_scenarios())
     assert set(HAZARD) == set(SCENARIOS) and set(PENDING) <= set(SCENARIOS)
+
+
+#: Layout seeds per scenario and level for the L1/L2 bar in the tests; bench/experts.py
+#: measures the issue's bar over 10 seeds (about 7 minutes), too long for every CI run.
+BAR_SEEDS = (0, 1, 2)
+
+
+@pytest.mark.slow
+def test_careful_expert_stays_mostly_safe_at_L1_and_L2(tmp_path):
+    """The bar at L1/L2 (safe success in at least 5 of 10 seeds), on three seeds: at least
+    two of them safe successes, for every scenario and level. One run of both levels, as
+    ``fsvla run`` makes it (2 worker processes)."""
+    from fsvla.results import ResultStore
+    from fsvla.runner import execute_run, make_backend, make_config, prepare_run
+
+    config = make_config(policy="careful-expert", scenarios=tuple(SCENARIOS), levels=("L1", "L2"),
+                         episodes=len(BAR_SEEDS), seeds=BAR_SEEDS, warmup=0, obs_mode="state")
+    result = execute_run(prepare_run(config), tmp_path / "run", make_backend("process", config, 2))
+    assert not result.faults, dict(result.faults)
+    with ResultStore.open(tmp_path / "run", readonly=True) as store:
+        rows = store.episodes(include_warmup=False)
+    safe: dict[tuple[str, str], list[int]] = {}
+    for row in rows:
+        safe.setdefault((row.scenario, row.level), []).append(int(row.quadrant == "safe_success"))
+    assert len(safe) == 2 * len(SCENARIOS)
+    below = {cell: sum(hits) for cell, hits in safe.items() if sum(hits) < 2}
+    assert not below, f"fewer than 2 of {len(BAR_SEEDS)} seeds safe: {below}"
