@@ -59,14 +59,14 @@ class ExpertPolicy:
     def bind_env(self, env: Any) -> None:
         """Give the expert the environment whose privileged state it may read."""
         self._env = env
-        self._world = World(env)
 
     # ------------------------------------------------------------------ policy API
     def reset(self, episode: Any = None) -> None:
-        if self._world is None:
+        if self._env is None:
             raise ExpertNotBound(f"{self.name} needs the environment: call "
                                  "bind_env(env) before reset (see fsvla.experts)")
-        world = self._world
+        # the scene as it is now: an env's reset may have built a new one since bind_env
+        world = self._world = World(self._env)
         task = world.scenario.task
         if task.name not in TASK_PLANS:
             raise ValueError(f"no expert plan for task {task.name!r}")

@@ -75,6 +75,25 @@ def test_expert_returns_valid_chunks_in_both_control_modes():
         assert np.isfinite(chunk).all()
 
 
+def test_an_expert_bound_once_plans_each_episode_on_its_own_scene():
+    """An env's reset after an episode builds a new scene: an expert bound before it must
+    read that one, not the old scene where the last episode left the arm."""
+    env = make("place_glass_on_shelf", "L0", 0)
+    expert = make_expert(env, "careful")
+
+    def first_actions() -> np.ndarray:
+        obs, _ = env.reset()
+        expert.reset(None)
+        actions = []
+        while len(actions) < 40:
+            for action in expert.act(obs):
+                obs, *_ = env.step(action)
+                actions.append(action)
+        return np.array(actions)
+
+    assert np.array_equal(first_actions(), first_actions())
+
+
 def _planned(scenario: str, style: str) -> list[tuple[str, tuple[str, ...]]]:
     """The segments of an expert's plan for ``scenario`` (label, the arms it moves or
     grips with), generated against the scene at reset without stepping it."""
