@@ -18,7 +18,7 @@ Contact scanning (see ``fsvla.monitor.probe``) is gated per control step: when t
 per-pair scan only concerns robot links, it runs in a control step only if, at the end
 of the previous one, a robot link's bounds lay within :data:`CONTACT_GATE` of another
 body's bounds. A link moving slower than 2 m/s travels less than that in one 50 ms
-control step, and PhysX makes no contact beyond its contact offset (about 1 cm).
+control step, and PhysX makes no contact beyond its contact offset (4 mm).
 """
 
 from __future__ import annotations

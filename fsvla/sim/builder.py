@@ -142,20 +142,21 @@ def build(spec: SceneSpec, *, render: bool | None = None, shader: str = DEFAULT_
     check_shader(shader)
     scene = _new_scene(spec.physics, render)
     renders = _has_render(scene)
-    ground = scene.add_ground(spec.ground_z, render=renders,
-                              render_material=_floor_material() if renders else None)
-    bodies: dict[str, Any] = {}
-    articulations: dict[str, Any] = {}
-    with tempfile.TemporaryDirectory(prefix="fsvla-scene-") as tmp:
-        for body in spec.bodies:
-            if isinstance(body.asset, RigidAsset):
-                bodies[body.name] = _build_rigid(scene, body, body.asset, renders)
-            else:
-                articulations[body.name] = _build_articulated(scene, body, body.asset,
-                                                              Path(tmp), renders)
-    zones = {zone.name: entity for zone in spec.zones
-             if (entity := _build_zone(scene, zone, zone.marker, renders)) is not None}
-    robot = load_robot(scene, spec.embodiment)
+    with _shape_config(spec.physics):  # every collision shape is made in here
+        ground = scene.add_ground(spec.ground_z, render=renders,
+                                  render_material=_floor_material() if renders else None)
+        bodies: dict[str, Any] = {}
+        articulations: dict[str, Any] = {}
+        with tempfile.TemporaryDirectory(prefix="fsvla-scene-") as tmp:
+            for body in spec.bodies:
+                if isinstance(body.asset, RigidAsset):
+                    bodies[body.name] = _build_rigid(scene, body, body.asset, renders)
+                else:
+                    articulations[body.name] = _build_articulated(scene, body, body.asset,
+                                                                  Path(tmp), renders)
+        zones = {zone.name: entity for zone in spec.zones
+                 if (entity := _build_zone(scene, zone, zone.marker, renders)) is not None}
+        robot = load_robot(scene, spec.embodiment)
     _place_robots(robot, spec)
     robot.reset_home()
     cameras: dict[str, Any] = {}
@@ -185,6 +186,22 @@ def _scene_config(physics: PhysicsSpec) -> Iterator[None]:
         yield
     finally:
         sapien.physx.set_scene_config(previous)
+
+
+@contextlib.contextmanager
+def _shape_config(physics: PhysicsSpec) -> Iterator[None]:
+    """SAPIEN gives a collision shape the contact offset of its global shape config when
+    the shape is made: set the scene's for that time and put the previous config back."""
+    import sapien
+
+    previous = sapien.physx.get_shape_config()
+    config = sapien.physx.get_shape_config()
+    config.contact_offset = physics.contact_offset
+    sapien.physx.set_shape_config(config)
+    try:
+        yield
+    finally:
+        sapien.physx.set_shape_config(previous)
 
 
 def _new_scene(physics: PhysicsSpec, render: bool | None) -> Any:
