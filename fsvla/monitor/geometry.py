@@ -8,13 +8,13 @@ axis-aligned bounds of every piece, and of every frame (the box around its piece
 one compiled pass (``fsvla.monitor.kernels``); FCL transforms are set lazily, only for
 pieces an exact query touches. :meth:`SceneGeometry.prefetch` gives each distance query
 of a step the gap between its groups' nearest frames, in one call; a query already that
-far answers with it. Otherwise :meth:`SceneGeometry.distance` visits the piece pairs of two groups in
-order of their bounds' gap and stops once that gap exceeds the best exact distance found
-(or, overlapping pieces found, once bounds stop overlapping: the deepest penetration),
-so the minimum is exact while far pairs cost nothing. Given ``exact_below`` it also
-stops once the gap reaches that value: the answer
-is then a lower bound no smaller than ``exact_below`` (channels pass their limit plus
-soft threshold plus ``EXACT_BAND``, so states and costs stay exact). Results are memoised
+far answers with it. Otherwise :meth:`SceneGeometry.distance` visits the piece pairs of
+two groups in order of their bounds' gap and stops once that gap exceeds the best exact
+distance found (or, overlapping pieces found, once bounds stop overlapping: the deepest
+penetration), so the minimum is exact while far pairs cost nothing. Given
+``exact_below`` it also stops once the gap reaches that value: the answer is then a
+lower bound no smaller than ``exact_below`` (channels pass their limit plus soft
+threshold plus ``EXACT_BAND``, so states and costs stay exact). Results are memoised
 until a frame of either group moves by more than ``POSE_TOLERANCE``.
 """
 
