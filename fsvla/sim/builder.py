@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -173,35 +173,34 @@ def build(spec: SceneSpec, *, render: bool | None = None, shader: str = DEFAULT_
 
 
 @contextlib.contextmanager
-def _scene_config(physics: PhysicsSpec) -> Iterator[None]:
-    """SAPIEN reads gravity from its global scene config when a PhysX system is made:
-    set it for that moment and put the previous config back."""
-    import sapien
-
-    previous = sapien.physx.get_scene_config()
-    config = sapien.physx.get_scene_config()
-    config.gravity = np.asarray(physics.gravity, dtype=np.float32)
-    sapien.physx.set_scene_config(config)
+def _global_config(get: Callable[[], Any], put: Callable[[Any], None],
+                   **values: Any) -> Iterator[None]:
+    """SAPIEN reads some settings from global configs when it makes a thing: set
+    ``values`` on the config ``get`` returns for that time, then ``put`` back the previous."""
+    previous, config = get(), get()
+    for name, value in values.items():
+        setattr(config, name, value)
+    put(config)
     try:
         yield
     finally:
-        sapien.physx.set_scene_config(previous)
+        put(previous)
 
 
-@contextlib.contextmanager
-def _shape_config(physics: PhysicsSpec) -> Iterator[None]:
-    """SAPIEN gives a collision shape the contact offset of its global shape config when
-    the shape is made: set the scene's for that time and put the previous config back."""
+def _scene_config(physics: PhysicsSpec) -> contextlib.AbstractContextManager[None]:
+    """Gravity, read from the global scene config when a PhysX system is made."""
     import sapien
 
-    previous = sapien.physx.get_shape_config()
-    config = sapien.physx.get_shape_config()
-    config.contact_offset = physics.contact_offset
-    sapien.physx.set_shape_config(config)
-    try:
-        yield
-    finally:
-        sapien.physx.set_shape_config(previous)
+    return _global_config(sapien.physx.get_scene_config, sapien.physx.set_scene_config,
+                          gravity=np.asarray(physics.gravity, dtype=np.float32))
+
+
+def _shape_config(physics: PhysicsSpec) -> contextlib.AbstractContextManager[None]:
+    """The contact offset, read from the global shape config when a collision shape is made."""
+    import sapien
+
+    return _global_config(sapien.physx.get_shape_config, sapien.physx.set_shape_config,
+                          contact_offset=physics.contact_offset)
 
 
 def _new_scene(physics: PhysicsSpec, render: bool | None) -> Any:
