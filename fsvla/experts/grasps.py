@@ -195,11 +195,10 @@ def reach_handle(world: World, arm: str, obj: str, handle: str, back: float = 0.
     handle, and up by ``lift`` (m); the horizontal one when no pitch is."""
     from .skills import branch_for_path
 
-    up = np.array([0.0, 0.0, 1.0])
     for pitch in np.deg2rad(HANDLE_PITCHES):
         grasp = handle_grasp(world, arm, obj, handle, float(pitch))
         pre = grasp.pose.moved(-back * grasp.approach)
-        path = (pre.moved(0.1 * up), pre, grasp.pose, grasp.pose.moved(lift * up))
+        path = (pre.moved(0.1 * UPV), pre, grasp.pose, grasp.pose.moved(lift * UPV))
         if branch_for_path(world, arm, path) is not None:
             return grasp
     return handle_grasp(world, arm, obj, handle)

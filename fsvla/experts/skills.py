@@ -104,15 +104,21 @@ def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
     return replace(style, grip_force=force)
 
 
+def _grasp_offset(world: World, arm: str, obj: str,
+                  tcp: Pose | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(centre of ``obj`` minus the grasp at ``tcp``, default where the hand is; the
+    fingers' closing axis in the world)."""
+    tcp = world.current_pose(arm) if tcp is None else tcp
+    lo, hi = world.bounds(obj)
+    return 0.5 * (lo + hi) - tcp.p, tcp.R @ world.finger_axis(arm)
+
+
 def grasp_lever(world: World, arm: str, obj: str, tcp: Pose | None = None) -> float:
     """Horizontal distance (m) from the grasp at ``tcp`` (default: where the hand is) to
     the centre of ``obj``, across the fingers' closing axis: the lever its weight turns it
     about the closing axis with."""
-    tcp = world.current_pose(arm) if tcp is None else tcp
-    lo, hi = world.bounds(obj)
-    d = 0.5 * (lo + hi) - tcp.p
+    d, closing = _grasp_offset(world, arm, obj, tcp)
     d[2] = 0.0
-    closing = tcp.R @ world.finger_axis(arm)
     d -= (d @ closing) * closing
     d[2] = 0.0
     return float(np.linalg.norm(d))
@@ -122,10 +128,7 @@ def grasp_tip(world: World, arm: str, obj: str, tcp: Pose | None = None) -> floa
     """Horizontal distance (m) from the grasp at ``tcp`` (default: where the hand is) to
     the centre of ``obj``, along the fingers' closing axis: the lever its weight tips it
     across that axis with (a mug held by its handle hangs out beside the fingers)."""
-    tcp = world.current_pose(arm) if tcp is None else tcp
-    lo, hi = world.bounds(obj)
-    d = 0.5 * (lo + hi) - tcp.p
-    closing = tcp.R @ world.finger_axis(arm)
+    d, closing = _grasp_offset(world, arm, obj, tcp)
     closing = np.array([closing[0], closing[1], 0.0])
     return float(abs(d @ closing))
 
