@@ -159,7 +159,8 @@ class ProcessBackend:
                     raise BackendError("no worker process is left to run episodes")
                 break
             wait([s.conn for s in active] + [s.process.sentinel for s in active], POLL_S)
-            finished = [f for f in (self._check(slot, bool(pending)) for slot in active) if f is not None]
+            checked = (self._check(slot, bool(pending)) for slot in active)
+            finished = [f for f in checked if f is not None]
             # the workers that finished get their next episode before the caller records
             # these (a trace write and a database commit): they do not wait for the writer
             self._hand_out(pending)
