@@ -24,10 +24,15 @@ through a substep, a reading would find what the previous one found: the probe s
 and reuses that reading (:attr:`Probe.guards`; the argument is in ``docs/monitor.md``).
 
 A contact's impulses act on its first body; the second gets their opposite.
+
+Both readings run natively where they can (``fsvla.monitor.native``: one call a substep
+instead of Python objects per contact point); this module's Python loops are the
+fallback and the reference the native reader is tested against.
 """
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -35,10 +40,11 @@ from typing import Any
 
 import numpy as np
 
-from .state import ContactMaxima, PoseMap, WorldState, link_frame, pair_key, robot_frame
+from .native import FreeBodySpec, NativeReader, NativeUnavailable, native_library
+from .state import NET, ContactMaxima, PoseMap, WorldState, link_frame, pair_key, robot_frame
 
-#: The "other side" of a body's net contact force in ContactMaxima keys.
-NET = "*"
+log = logging.getLogger(__name__)
+
 _ZERO = [0.0, 0.0, 0.0]
 
 
@@ -168,7 +174,7 @@ class Probe:
                  torque_frames: Iterable[str] = (), scan: ContactFilter = ContactFilter(),
                  last: ContactFilter = ContactFilter(),
                  joints: Mapping[str, tuple[Any, int]] | None = None,
-                 gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)):
+                 gravity: tuple[float, float, float] = (0.0, 0.0, -9.81), native: bool = True):
         self._scene = scene
         self._physx = getattr(scene, "physx_system", scene)
         self._dt = float(timestep)
@@ -201,10 +207,40 @@ class Probe:
         self.scan = True  # the per-substep pair scan runs
         self.read_last = True  # snapshot(contacts=True) reads the last substep's contacts
         self.guards = True  # sleeping guard bodies spare the scans (off: every reading is taken)
+        self._native_scan, self._native_last = self._native_readers(g) if native else (None, None)
+
+    def _native_readers(self, gravity: tuple[float, float, float]) -> tuple[
+            NativeReader | None, NativeReader | None]:
+        """(substep reader, last-substep reader) in native code, or (None, None)."""
+        library = native_library()
+        if library is None:
+            return None, None
+        try:
+            free = [FreeBodySpec(b.frame, b.c, b.torque, gravity) for b in self._free]
+            scan = NativeReader(library, self._physx, self.components, any_pair=self._filter.any_pair,
+                                robot_pairs=self._filter.robot_pairs, torque=self._torque, free_bodies=free)
+            last = NativeReader(library, self._physx, self.components, any_pair=self._last.any_pair,
+                                robot_pairs=self._last.robot_pairs) if self._last else None
+        except NativeUnavailable as error:
+            log.info("reading this scene's contacts in Python: %s", error)
+            return None, None
+        return scan, last
+
+    @property
+    def native(self) -> bool:
+        """Whether contacts are read by the native reader."""
+        return self._native_scan is not None
 
     @property
     def records_substeps(self) -> bool:
         return bool(self._free) or bool(self._filter)
+
+    def maxima_so_far(self) -> ContactMaxima:
+        """The maxima recorded since the last snapshot (a copy; the snapshot takes them)."""
+        maxima = ContactMaxima(dict(self.maxima.force), dict(self.maxima.torque))
+        if self._native_scan is not None:
+            self._native_scan.take(maxima, clear=False)
+        return maxima
 
     def frame_of(self, component: Any) -> str:
         return self._frame_of.get(id(component)) or f"?{component.entity.name}"
@@ -216,10 +252,15 @@ class Probe:
         self._scan_slept = self._last_slept = False
         for body in self._free:
             body.read()
+        if self._native_scan is not None:
+            self._native_scan.reset()
 
     def record_substep(self) -> None:
         """Fold the physics step just taken into the control step's maxima."""
         inv_dt = 1.0 / self._dt
+        if self._native_scan is not None:
+            self._native_scan.fold(inv_dt, self.scan and bool(self._filter))
+            return
         for body in self._free:
             body.record(self.maxima, inv_dt)
         if self.scan and self._filter:
@@ -348,6 +389,8 @@ class Probe:
         """Force on the first frame by the second, for the wanted contacts of the last
         substep. Reused from the last reading while its guard bodies slept through every
         substep since (their contacts were not reported again)."""
+        if self._native_last is not None:
+            return self._native_last.read(1.0 / self._dt)
         if self._last_slept and self._last_memo is not None and self.guards:
             return {k: v.copy() for k, v in self._last_memo.items()}
         forces = self._read_last()
@@ -394,6 +437,8 @@ class Probe:
             if q is None:
                 q = qpos[id(a)] = a.get_qpos()
             joints[k] = float(q[i])
+        if self._native_scan is not None:
+            self._native_scan.take(self.maxima)
         state = WorldState(step=step, time=time, poses=self.poses(), joints=joints,
                            contact_force=dict(self.maxima.force), contact_torque=dict(self.maxima.torque),
                            last_contacts=self.last_contacts() if contacts and self.read_last else {},

@@ -28,6 +28,9 @@ from numpy.typing import NDArray
 Matrix4 = NDArray[np.float64]
 Pair = tuple[str, str]
 
+#: The "other side" of a free body's net contact force (and torque) in ContactMaxima keys.
+NET = "*"
+
 
 def robot_frame(robot: str, link: str) -> str:
     return f"@{robot}:{link}"
@@ -116,4 +119,4 @@ class WorldState:
         return total
 
 
-__all__ = ["ContactMaxima", "Matrix4", "Pair", "PoseMap", "WorldState", "link_frame", "pair_key", "robot_frame"]
+__all__ = ["NET", "ContactMaxima", "Matrix4", "Pair", "PoseMap", "WorldState", "link_frame", "pair_key", "robot_frame"]

@@ -1,0 +1,333 @@
+"""The native contact reader (``native/contacts.cpp``): built on first use, loaded, used.
+
+Reading contacts through SAPIEN's Python bindings costs microseconds a contact point, 25
+substeps a control step, and is most of the monitor's cost while a gripper holds a
+watched object (``docs/monitor.md``). The native reader folds the same quantities as
+:class:`fsvla.monitor.probe.Probe`'s Python reader (free bodies' net force and torque,
+kept pairs' force and torque maxima, the last substep's pair forces) straight from the
+report map SAPIEN keeps, in one call a substep.
+
+It is compiled once per SAPIEN version and source into a cache folder
+(``$FSVLA_CACHE_DIR``, else ``$XDG_CACHE_HOME/fsvla``, else ``~/.cache/fsvla``) with the
+system C++ compiler (``$CXX``, else ``c++``) against the headers SAPIEN's wheel ships and
+Eigen's (``$EIGEN_INCLUDE_DIR``, else ``/usr/include/eigen3``). Pointers come from
+pybind11's cross-module conduit, so nothing links against SAPIEN's module. Where any of
+this fails (no compiler, no Eigen, another SAPIEN build), :func:`native_library` says why
+in the log and returns None, and the probe reads contacts in Python: slower, the same
+numbers. ``FSVLA_NATIVE_CONTACTS=0`` turns the native reader off.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import hashlib
+import logging
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .state import NET, ContactMaxima
+
+log = logging.getLogger(__name__)
+
+SOURCE = Path(__file__).with_name("native") / "contacts.cpp"
+SWITCH = "FSVLA_NATIVE_CONTACTS"
+_ROWS = 64  # initial capacity of the row buffers; they grow when a reading needs more
+
+# flags of a frame in a reader (contacts.cpp's Flags)
+ANY_PAIR, ROBOT_PAIRS, TORQUE, ROBOT_LINK = 1, 2, 4, 8
+
+
+class NativeUnavailable(RuntimeError):
+    """Why the native reader cannot be used here."""
+
+
+def cache_dir() -> Path:
+    root = os.environ.get("FSVLA_CACHE_DIR")
+    if root:
+        return Path(root)
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg) if xdg else Path.home() / ".cache") / "fsvla"
+
+
+def _sapien_include() -> Path:
+    import sapien
+
+    include = Path(sapien.__file__).parent / "include"
+    if not (include / "sapien" / "physx" / "simulation_callback.hpp").is_file():
+        raise NativeUnavailable(f"SAPIEN {sapien.__version__} ships no C++ headers ({include})")
+    return include
+
+
+def _eigen_include() -> Path:
+    for candidate in (os.environ.get("EIGEN_INCLUDE_DIR"), "/usr/include/eigen3", "/usr/local/include/eigen3"):
+        if candidate and (Path(candidate) / "Eigen" / "Dense").is_file():
+            return Path(candidate)
+    raise NativeUnavailable("Eigen's headers were not found (install libeigen3-dev, or set EIGEN_INCLUDE_DIR)")
+
+
+def _compiler() -> str:
+    compiler = os.environ.get("CXX") or shutil.which("c++") or shutil.which("g++")
+    if not compiler:
+        raise NativeUnavailable("no C++ compiler (install g++, or set CXX)")
+    return compiler
+
+
+def build(target_dir: Path | None = None) -> Path:
+    """The shared library, compiled now unless the cache holds this source's build for this
+    SAPIEN. Raises :class:`NativeUnavailable` with the reason when it cannot be built."""
+    import sapien
+
+    include, eigen, compiler = _sapien_include(), _eigen_include(), _compiler()
+    digest = hashlib.sha256()
+    for part in (SOURCE.read_bytes(), sapien.__version__.encode(), str(include).encode(), compiler.encode()):
+        digest.update(part)
+    folder = target_dir or cache_dir() / "native"
+    target = folder / f"contacts-{digest.hexdigest()[:16]}.so"
+    if target.is_file():
+        return target
+    folder.mkdir(parents=True, exist_ok=True)
+    # a private name, then an atomic rename: processes building at once never see a part
+    fd, partial = tempfile.mkstemp(dir=folder, prefix=".contacts-", suffix=".so")
+    os.close(fd)
+    command = [compiler, "-O2", "-std=c++20", "-shared", "-fPIC", "-Wl,-z,defs", "-w",
+               f"-I{include}", f"-I{include / 'physx' / 'include'}", f"-I{eigen}", str(SOURCE), "-o", partial]
+    try:
+        try:
+            done = subprocess.run(command, capture_output=True, text=True, timeout=300)
+        except (OSError, subprocess.SubprocessError) as error:
+            raise NativeUnavailable(f"could not run the C++ compiler {compiler!r}: {error}") from error
+        if done.returncode != 0:
+            tail = " ".join(done.stderr.strip().splitlines()[-3:])
+            raise NativeUnavailable(f"compiling {SOURCE.name} failed: {tail}")
+        os.replace(partial, target)
+    finally:
+        if os.path.exists(partial):
+            os.unlink(partial)
+    return target
+
+
+class NativeLibrary:
+    """The loaded reader library and the means to get SAPIEN's C++ pointers."""
+
+    def __init__(self, path: Path):
+        lib = ctypes.CDLL(str(path))
+        p, u64, i64, f64 = ctypes.c_void_p, ctypes.POINTER(ctypes.c_uint64), ctypes.c_int64, ctypes.c_double
+        f64p = ctypes.POINTER(ctypes.c_double)
+        for name, restype, argtypes in (
+                ("fsvla_system_type", p, []), ("fsvla_component_type", p, []),
+                ("fsvla_contact_count", i64, [p]),
+                ("fsvla_reader_new", p, [p]), ("fsvla_reader_free", None, [p]),
+                ("fsvla_reader_set", None, [p, p, ctypes.c_uint32, ctypes.c_int32]),
+                ("fsvla_reader_add_free", None, [p, p, ctypes.c_int32, f64, f64p, f64p, f64p]),
+                ("fsvla_reader_reset", None, [p]),
+                ("fsvla_reader_fold", None, [p, f64, ctypes.c_int32]),
+                ("fsvla_reader_take_free", None, [p, f64p, ctypes.c_int32]),
+                ("fsvla_reader_take", i64, [p, u64, f64p, i64, ctypes.c_int32]),
+                ("fsvla_reader_read", i64, [p, u64, f64p, i64]),
+                ("fsvla_entity_name", i64, [p, ctypes.c_char_p, i64])):
+            function = getattr(lib, name)
+            function.restype, function.argtypes = restype, argtypes
+        self.lib = lib
+        # private prototypes of the C API (ctypes.pythonapi's function objects are shared)
+        self._capsule_new = _c_api("PyCapsule_New", ctypes.py_object, p, ctypes.c_char_p, p)  # a new reference
+        self._capsule_name = _c_api("PyCapsule_GetName", ctypes.c_char_p, ctypes.py_object)
+        self._capsule_pointer = _c_api("PyCapsule_GetPointer", p, ctypes.py_object, ctypes.c_char_p)
+        self._type_info_name = _type_info_capsule_name()
+        self._abi_ids = _pybind_abi_ids()
+
+    def pointer(self, obj: Any, type_info: int) -> int:
+        """The C++ pointer behind a SAPIEN object, as the type ``type_info`` names."""
+        capsule = self._capsule_new(type_info, self._type_info_name, None)
+        for abi in self._abi_ids:
+            conduit = getattr(obj, "_pybind11_conduit_v1_", None)
+            if conduit is None:
+                break
+            result = conduit(abi, capsule, b"raw_pointer_ephemeral")
+            if result is not None:
+                return int(self._capsule_pointer(result, self._capsule_name(result)))
+        raise NativeUnavailable(f"SAPIEN's bindings do not hand out a {type(obj).__name__}'s C++ pointer")
+
+    def system(self, physx_system: Any) -> int:
+        """The PhysxSystemCpu behind ``scene.physx_system``, checked against its contact list."""
+        pointer = self.pointer(physx_system, self.lib.fsvla_system_type())
+        if self.lib.fsvla_contact_count(pointer) != len(physx_system.get_contacts()):
+            raise NativeUnavailable("the native contact map disagrees with SAPIEN's contact list")
+        return pointer
+
+    def component(self, component: Any) -> int:
+        return self.pointer(component, self.lib.fsvla_component_type())
+
+    def entity_name(self, pointer: int) -> str:
+        buffer = ctypes.create_string_buffer(256)
+        n = self.lib.fsvla_entity_name(pointer, buffer, len(buffer))
+        if n >= len(buffer):
+            buffer = ctypes.create_string_buffer(n + 1)
+            self.lib.fsvla_entity_name(pointer, buffer, len(buffer))
+        return buffer.value.decode("utf-8", "replace")
+
+
+def _type_info_capsule_name() -> bytes:
+    """``typeid(std::type_info).name()`` for the C++ runtime SAPIEN uses (libstdc++)."""
+    return b"St9type_info"
+
+
+def _c_api(name: str, restype: Any, *argtypes: Any) -> Any:
+    return ctypes.PYFUNCTYPE(restype, *argtypes)((name, ctypes.pythonapi))
+
+
+def _pybind_abi_ids() -> tuple[bytes, ...]:
+    """The platform ABI ids of the pybind11 modules loaded in this interpreter (the keys
+    of their shared internals), e.g. ``system_libstdcpp_gxx_abi_1xxx_use_cxx11_abi_1``."""
+    interpreter = _c_api("PyInterpreterState_Get", ctypes.c_void_p)()
+    # a borrowed reference: taken as an address and read as an object (which counts it)
+    address = _c_api("PyInterpreterState_GetDict", ctypes.c_void_p, ctypes.c_void_p)(interpreter)
+    state = ctypes.cast(address, ctypes.py_object).value if address else {}
+    ids = []
+    for key in list(state):
+        match = re.fullmatch(r"__pybind11_internals_v\d+_(.+)__", str(key))
+        if match:
+            ids.append(match.group(1).encode())
+    return tuple(ids)
+
+
+@functools.cache
+def native_library() -> NativeLibrary | None:
+    """The native reader library for this process, or None (the reason is logged once)."""
+    if os.environ.get(SWITCH, "1").strip().lower() in {"0", "false", "no", "off"}:
+        log.info("native contact reader switched off (%s)", SWITCH)
+        return None
+    try:
+        import sapien  # noqa: F401  (its bindings register the types the conduit finds)
+
+        return NativeLibrary(build())
+    except (NativeUnavailable, OSError, subprocess.SubprocessError) as error:
+        log.warning("native contact reader unavailable, reading contacts in Python: %s", error)
+        return None
+
+
+@dataclass(frozen=True)
+class FreeBodySpec:
+    """A free body whose net contact force (and torque) the reader folds every substep."""
+
+    frame: str
+    component: Any
+    torque: bool
+    gravity: tuple[float, float, float]
+
+
+class NativeReader:
+    """One filter's reading over one scene: per-substep folds, maxima taken per control
+    step (:meth:`take`), or the current reports' pair impulses (:meth:`read`)."""
+
+    def __init__(self, library: NativeLibrary, physx_system: Any, components: Mapping[str, Any], *,
+                 any_pair: Iterable[str] = (), robot_pairs: Iterable[str] = (), torque: Iterable[str] = (),
+                 free_bodies: Sequence[FreeBodySpec] = ()):
+        self._library, lib = library, library.lib
+        self._lib = lib
+        self._handle = lib.fsvla_reader_new(library.system(physx_system))
+        any_pair, robot_pairs, torque = frozenset(any_pair), frozenset(robot_pairs), frozenset(torque)
+        robots: dict[str, int] = {}
+        self._frames: dict[int, str] = {}
+        for frame, component in components.items():
+            pointer = library.component(component)
+            flags = ((ANY_PAIR if frame in any_pair else 0) | (ROBOT_PAIRS if frame in robot_pairs else 0)
+                     | (TORQUE if frame in torque else 0))
+            robot = -1
+            if frame.startswith("@"):
+                flags |= ROBOT_LINK
+                robot = robots.setdefault(frame.split(":", 1)[0], len(robots))
+            lib.fsvla_reader_set(self._handle, pointer, flags, robot)
+            self._frames[pointer] = frame
+        self._free = [body.frame for body in free_bodies]
+        for body in free_bodies:
+            c = body.component
+            inertia = (ctypes.c_double * 3)(*(float(v) for v in c.inertia))
+            cmass_q = (ctypes.c_double * 4)(*(float(v) for v in c.cmass_local_pose.q))
+            gravity = (ctypes.c_double * 3)(*body.gravity)
+            lib.fsvla_reader_add_free(self._handle, library.component(c), int(body.torque), float(c.mass),
+                                      inertia, cmass_q, gravity)
+        self._free_values = np.zeros(2 * max(len(self._free), 1))
+        self._grow(_ROWS)
+
+    def _grow(self, rows: int) -> None:
+        self._pairs = np.zeros(2 * rows, dtype=np.uint64)
+        self._values = np.zeros(3 * rows)
+        self._rows = rows
+        self._pairs_arg = self._pairs.ctypes.data_as(ctypes.POINTER(ctypes.c_uint64))
+        self._values_arg = self._values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+    def __del__(self) -> None:
+        handle, self._handle = getattr(self, "_handle", None), None
+        if handle:
+            self._lib.fsvla_reader_free(handle)
+
+    def frame(self, pointer: int) -> str:
+        """The frame of a component pointer; ``?<entity name>`` for a body outside the map."""
+        frame = self._frames.get(pointer)
+        if frame is None:
+            frame = self._frames[pointer] = f"?{self._library.entity_name(pointer)}"
+        return frame
+
+    def reset(self) -> None:
+        """Forget the maxima and re-read the free bodies' velocities."""
+        self._lib.fsvla_reader_reset(self._handle)
+
+    def fold(self, inv_dt: float, scan: bool) -> None:
+        """Fold the substep just taken: free bodies, and the kept pairs if ``scan``."""
+        self._lib.fsvla_reader_fold(self._handle, inv_dt, scan)
+
+    def take(self, maxima: ContactMaxima, clear: bool = True) -> None:
+        """Add the maxima folded since the last take to ``maxima``, then forget them
+        (unless not ``clear``)."""
+        if self._free:
+            self._lib.fsvla_reader_take_free(self._handle, self._free_values.ctypes.data_as(
+                ctypes.POINTER(ctypes.c_double)), clear)
+            for i, frame in enumerate(self._free):
+                force, torque = self._free_values[2 * i], self._free_values[2 * i + 1]
+                if force >= 0.0:
+                    maxima.add_force(frame, NET, float(force))
+                if torque >= 0.0:
+                    maxima.add_torque(frame, NET, float(torque))
+        n = self._call(self._lib.fsvla_reader_take, clear)
+        pairs, values = self._pairs, self._values
+        for i in range(n):
+            a, b = self.frame(int(pairs[2 * i])), self.frame(int(pairs[2 * i + 1]))
+            force, torque_a, torque_b = values[3 * i:3 * i + 3].tolist()
+            if force > 0.0:
+                maxima.add_force(a, b, force)
+            if torque_a > 0.0:
+                maxima.add_torque(a, b, torque_a)
+            if torque_b > 0.0:
+                maxima.add_torque(b, a, torque_b)
+
+    def read(self, inv_dt: float) -> dict[tuple[str, str], np.ndarray]:
+        """Force on the first frame by the second, both orders, for the kept pairs of the
+        current reports (the last substep)."""
+        n = self._call(self._lib.fsvla_reader_read)
+        forces: dict[tuple[str, str], np.ndarray] = {}
+        for i in range(n):
+            a, b = self.frame(int(self._pairs[2 * i])), self.frame(int(self._pairs[2 * i + 1]))
+            force = self._values[3 * i:3 * i + 3] * inv_dt
+            forces[(a, b)] = forces.get((a, b), 0.0) + force
+            forces[(b, a)] = forces.get((b, a), 0.0) - force
+        return forces
+
+    def _call(self, function: Any, *args: Any) -> int:
+        n = function(self._handle, self._pairs_arg, self._values_arg, self._rows, *args)
+        if n < 0:  # more rows than the buffers hold: grow and ask again
+            self._grow(2 * -n)
+            n = function(self._handle, self._pairs_arg, self._values_arg, self._rows, *args)
+        return n
+
+
+__all__ = ["FreeBodySpec", "NativeLibrary", "NativeReader", "NativeUnavailable", "build", "native_library"]
