@@ -40,6 +40,7 @@ import numpy as np
 
 from fsvla.compiler.monitor import METRIC_NAMES, ChannelSpec, MonitorSpec
 
+from . import kernels
 from .geometry import MAX_DISTANCE, SceneGeometry
 from .layout import Layout
 from .state import WorldState
@@ -77,18 +78,20 @@ def _edge_clearance(ch: ChannelSpec, layout: Layout) -> Measure:
     support = layout.bodies[ch.support or "table"]
     subjects = [layout.frames(s) for s in ch.subjects]
     (x0, y0), (x1, y1) = support.footprint
+    moving = frozenset().union(*subjects, {support.root_frame})
+    memo: list[tuple[SceneGeometry, int, float]] = []  # the last answer, while nothing moved
 
     def measure(state: WorldState, geo: SceneGeometry) -> float:
+        version = geo.version(moving)
+        if memo and memo[0][0] is geo and memo[0][1] == version:
+            return memo[0][2]
         pose = geo.pose(support.root_frame) if geo.has(support.root_frame) else np.eye(4)
         best = MAX_DISTANCE
         for frames in subjects:
             points = geo.points(frames)
-            if len(points) == 0:
-                continue
-            local = (points - pose[:3, 3]) @ pose[:3, :3]  # into the support's frame
-            inside = np.minimum(np.minimum(local[:, 0] - x0, x1 - local[:, 0]),
-                                np.minimum(local[:, 1] - y0, y1 - local[:, 1]))
-            best = min(best, float(inside.min()))
+            if len(points):  # in the support's frame, to its footprint's nearest edge
+                best = min(best, kernels.inside_margin(points, pose, x0, y0, x1, y1))
+        memo[:] = [(geo, version, best)]
         return best
 
     return measure

@@ -134,5 +134,20 @@ def columns_within(lo: NDArray[np.float64], hi: NDArray[np.float64], a: NDArray[
     return out
 
 
-__all__ = ["any_within", "apply_poses", "columns_within", "nearest_per_query", "pair_distances",
+@njit(cache=True, nogil=True)
+def inside_margin(points: NDArray[np.float64], pose: NDArray[np.float64], x0: float, y0: float,
+                  x1: float, y1: float) -> float:
+    """The smallest distance, in the xy-plane of ``pose``'s frame, from a point of ``points``
+    (world) to the edges of the rectangle [x0, x1] × [y0, y1] there: negative for a point
+    outside it; infinity for no points."""
+    best = np.inf
+    for k in range(points.shape[0]):
+        dx, dy, dz = points[k, 0] - pose[0, 3], points[k, 1] - pose[1, 3], points[k, 2] - pose[2, 3]
+        x = dx * pose[0, 0] + dy * pose[1, 0] + dz * pose[2, 0]
+        y = dx * pose[0, 1] + dy * pose[1, 1] + dz * pose[2, 1]
+        best = min(best, x - x0, x1 - x, y - y0, y1 - y)
+    return best
+
+
+__all__ = ["any_within", "apply_poses", "columns_within", "inside_margin", "nearest_per_query", "pair_distances",
            "update_bounds"]

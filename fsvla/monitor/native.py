@@ -134,6 +134,7 @@ class NativeLibrary:
                 ("fsvla_reader_take_free", None, [p, f64p, ctypes.c_int32]),
                 ("fsvla_reader_take", i64, [p, u64, f64p, i64, ctypes.c_int32]),
                 ("fsvla_reader_read", i64, [p, u64, f64p, i64]),
+                ("fsvla_poses", None, [p, i64, p]),
                 ("fsvla_entity_name", i64, [p, ctypes.c_char_p, i64])):
             function = getattr(lib, name)
             function.restype, function.argtypes = restype, argtypes
@@ -215,6 +216,22 @@ def native_library() -> NativeLibrary | None:
         return None
 
 
+class NativePoses:
+    """World poses of a fixed list of components, read in one call: the matrices SAPIEN's
+    ``entity_pose.to_transformation_matrix()`` gives, bit for bit."""
+
+    def __init__(self, library: NativeLibrary, components: Sequence[Any]):
+        self._poses = library.lib.fsvla_poses
+        self._pointers = np.array([library.component(c) for c in components], dtype=np.uint64)
+        self._address, self._n = self._pointers.ctypes.data, len(self._pointers)
+
+    def read(self) -> np.ndarray:
+        """A new (n, 4, 4) float32 array."""
+        out = np.empty((self._n, 4, 4), dtype=np.float32)
+        self._poses(self._address, self._n, out.ctypes.data)
+        return out
+
+
 @dataclass(frozen=True)
 class FreeBodySpec:
     """A free body whose net contact force (and torque) the reader folds every substep."""
@@ -257,6 +274,7 @@ class NativeReader:
             lib.fsvla_reader_add_free(self._handle, library.component(c), int(body.torque), float(c.mass),
                                       inertia, cmass_q, gravity)
         self._free_values = np.zeros(2 * max(len(self._free), 1))
+        self._free_arg = self._free_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._grow(_ROWS)
 
     def _grow(self, rows: int) -> None:
@@ -290,19 +308,21 @@ class NativeReader:
         """Add the maxima folded since the last take to ``maxima``, then forget them
         (unless not ``clear``)."""
         if self._free:
-            self._lib.fsvla_reader_take_free(self._handle, self._free_values.ctypes.data_as(
-                ctypes.POINTER(ctypes.c_double)), clear)
+            self._lib.fsvla_reader_take_free(self._handle, self._free_arg, clear)
+            values = self._free_values.tolist()
             for i, frame in enumerate(self._free):
-                force, torque = self._free_values[2 * i], self._free_values[2 * i + 1]
+                force, torque = values[2 * i], values[2 * i + 1]
                 if force >= 0.0:
-                    maxima.add_force(frame, NET, float(force))
+                    maxima.add_force(frame, NET, force)
                 if torque >= 0.0:
-                    maxima.add_torque(frame, NET, float(torque))
+                    maxima.add_torque(frame, NET, torque)
         n = self._call(self._lib.fsvla_reader_take, clear)
-        pairs, values = self._pairs, self._values
+        if not n:
+            return
+        pairs, values = self._pairs[:2 * n].tolist(), self._values[:3 * n].tolist()
         for i in range(n):
-            a, b = self.frame(int(pairs[2 * i])), self.frame(int(pairs[2 * i + 1]))
-            force, torque_a, torque_b = values[3 * i:3 * i + 3].tolist()
+            a, b = self.frame(pairs[2 * i]), self.frame(pairs[2 * i + 1])
+            force, torque_a, torque_b = values[3 * i:3 * i + 3]
             if force > 0.0:
                 maxima.add_force(a, b, force)
             if torque_a > 0.0:
@@ -315,11 +335,13 @@ class NativeReader:
         current reports (the last substep)."""
         n = self._call(self._lib.fsvla_reader_read)
         forces: dict[tuple[str, str], np.ndarray] = {}
-        for i in range(n):
-            a, b = self.frame(int(self._pairs[2 * i])), self.frame(int(self._pairs[2 * i + 1]))
-            force = self._values[3 * i:3 * i + 3] * inv_dt
-            forces[(a, b)] = forces.get((a, b), 0.0) + force
-            forces[(b, a)] = forces.get((b, a), 0.0) - force
+        if not n:
+            return forces
+        pairs, impulses = self._pairs[:2 * n].tolist(), self._values[:3 * n] * inv_dt
+        for i in range(n):  # one row a component pair, and a frame is one component
+            a, b = self.frame(pairs[2 * i]), self.frame(pairs[2 * i + 1])
+            forces[(a, b)] = impulses[3 * i:3 * i + 3].copy()
+            forces[(b, a)] = -impulses[3 * i:3 * i + 3]
         return forces
 
     def _call(self, function: Any, *args: Any) -> int:
@@ -330,4 +352,4 @@ class NativeReader:
         return n
 
 
-__all__ = ["FreeBodySpec", "NativeLibrary", "NativeReader", "NativeUnavailable", "build", "native_library"]
+__all__ = ["FreeBodySpec", "NativeLibrary", "NativePoses", "NativeReader", "NativeUnavailable", "build", "native_library"]

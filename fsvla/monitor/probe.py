@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from .native import FreeBodySpec, NativeReader, NativeUnavailable, native_library
+from .native import FreeBodySpec, NativePoses, NativeReader, NativeUnavailable, native_library
 from .state import NET, ContactMaxima, PoseMap, WorldState, link_frame, pair_key, robot_frame
 
 log = logging.getLogger(__name__)
@@ -207,24 +207,26 @@ class Probe:
         self.scan = True  # the per-substep pair scan runs
         self.read_last = True  # snapshot(contacts=True) reads the last substep's contacts
         self.guards = True  # sleeping guard bodies spare the scans (off: every reading is taken)
-        self._native_scan, self._native_last = self._native_readers(g) if native else (None, None)
+        self._native_scan, self._native_last, self._native_poses = (
+            self._native_parts(g) if native else (None, None, None))
 
-    def _native_readers(self, gravity: tuple[float, float, float]) -> tuple[
-            NativeReader | None, NativeReader | None]:
-        """(substep reader, last-substep reader) in native code, or (None, None)."""
+    def _native_parts(self, gravity: tuple[float, float, float]) -> tuple[
+            NativeReader | None, NativeReader | None, NativePoses | None]:
+        """(substep reader, last-substep reader, pose reader) in native code, or Nones."""
         library = native_library()
         if library is None:
-            return None, None
+            return None, None, None
         try:
             free = [FreeBodySpec(b.frame, b.c, b.torque, gravity) for b in self._free]
             scan = NativeReader(library, self._physx, self.components, any_pair=self._filter.any_pair,
                                 robot_pairs=self._filter.robot_pairs, torque=self._torque, free_bodies=free)
             last = NativeReader(library, self._physx, self.components, any_pair=self._last.any_pair,
                                 robot_pairs=self._last.robot_pairs) if self._last else None
+            poses = NativePoses(library, self._pose_components) if self._pose_components else None
         except NativeUnavailable as error:
             log.info("reading this scene's contacts in Python: %s", error)
-            return None, None
-        return scan, last
+            return None, None, None
+        return scan, last, poses
 
     @property
     def native(self) -> bool:
@@ -424,6 +426,8 @@ class Probe:
     def poses(self) -> PoseMap:
         if not self._pose_frames:
             return PoseMap((), np.zeros((0, 4, 4), dtype=np.float32))
+        if self._native_poses is not None:
+            return PoseMap(self._pose_names, self._native_poses.read())
         return PoseMap(self._pose_names, np.array([c.entity_pose.to_transformation_matrix()
                                                    for c in self._pose_components]))
 

@@ -20,6 +20,8 @@
 #include <sapien/physx/rigid_component.h>
 #include <sapien/entity.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -315,6 +317,27 @@ int64_t fsvla_reader_read(void *reader, uint64_t *pairs, double *impulses, int64
     impulses[3 * i + 2] = s.impulse.z;
   }
   return n;
+}
+
+// World poses of n components as 4x4 row-major float32 matrices, as SAPIEN's
+// Pose.to_transformation_matrix computes them (an entity's pose is its actor's).
+void fsvla_poses(const uint64_t *components, int64_t n, float *out) {
+  for (int64_t i = 0; i < n; ++i) {
+    auto *component = reinterpret_cast<const PhysxRigidBaseComponent *>(components[i]);
+    ::physx::PxTransform pose = component->getPxActor()->getGlobalPose();
+    // normalized first, as SAPIEN does (Eigen, vectorised: the same roundings)
+    Eigen::Matrix3f rotation =
+        Eigen::Quaternionf(pose.q.w, pose.q.x, pose.q.y, pose.q.z).normalized().toRotationMatrix();
+    float *m = out + 16 * i;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m[4 * r + c] = rotation(r, c);
+    }
+    m[3] = pose.p.x;
+    m[7] = pose.p.y;
+    m[11] = pose.p.z;
+    m[12] = m[13] = m[14] = 0.0f;
+    m[15] = 1.0f;
+  }
 }
 
 // The name of a component's entity (for frames the monitor does not know), truncated to
