@@ -125,6 +125,8 @@ class SceneGeometry:
         self._batches: dict[tuple, tuple] = {}
         self._bounds_memo: dict[frozenset[str], tuple[int, tuple[NDArray[np.float64], NDArray[np.float64]]]] = {}
         self._prefetched: dict[tuple[frozenset[str], frozenset[str]], tuple[int, float]] = {}
+        self._moves_made = 0  # times set_poses moved a frame: the prefetch is current while equal
+        self._prefetched_at = -1
         self._moves: dict[tuple[str, ...], tuple[list[int], NDArray[np.int64]]] = {}
         self._group_frames: dict[frozenset[str], NDArray[np.int64]] = {}
         self._point_memo: dict[frozenset[str], tuple[int, NDArray[np.float64]]] = {}
@@ -223,6 +225,7 @@ class SceneGeometry:
         elif keep is not None:
             stack = stack[keep]
         if kernels.apply_poses(stack, frames, self._pose_array, self._stamp, POSE_TOLERANCE):
+            self._moves_made += 1
             self._update_bounds()
 
     def _update_bounds(self) -> None:
@@ -294,6 +297,7 @@ class SceneGeometry:
         nearest = np.empty(len(keys))
         kernels.nearest_per_query(self._flo, self._fhi, rows_a, rows_b, starts, nearest)
         self._prefetched = dict(zip(keys, zip(versions, nearest.tolist())))
+        self._prefetched_at = self._moves_made
 
     def frames_within(self, rows: NDArray[np.int64], cols: NDArray[np.int64], gap: float) -> bool:
         """Whether the world bounds of a frame of ``rows`` and one of ``cols`` (rows of
@@ -353,14 +357,17 @@ class SceneGeometry:
             self._freeze()
         key = (a, b)
         ia, ib, frames, same = self._pair(a, b)
-        version = int(self._stamp[frames].sum())
+        found = self._prefetched.get(key)
+        if found is not None and self._prefetched_at == self._moves_made:
+            version = found[0]  # nothing moved since the prefetch summed these stamps
+        else:
+            found, version = None, int(self._stamp[frames].sum())
         cached = self._memo.get(key)
         if cached is not None and cached[2] == version and (cached[0] < cached[1] or cached[1] >= exact_below):
             return cached[0]
         if len(ia) == 0 or len(ib) == 0:
             return MAX_DISTANCE
-        found = self._prefetched.get(key)
-        if found is not None and found[0] == version and found[1] >= exact_below:
+        if found is not None and found[1] >= exact_below:
             self._memo[key] = (found[1], exact_below, version)  # far at the frame level already
             return found[1]
         bound = np.empty(len(ia) * len(ib))

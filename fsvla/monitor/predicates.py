@@ -179,11 +179,16 @@ def _on(p: Predicate, s: Scope) -> bool:
     top, base = p.args
     info = s.layout.bodies[base]
     pose = s.root_pose(base)
-    local = _to_local(s.centre(top), pose)
+    # the top's centre in the base's frame, in plain floats (numpy's per-call cost
+    # dominates three-vectors; this runs every step for most success conditions)
+    (r0, r1, r2, px), (r3, r4, r5, py), (r6, r7, r8, pz) = pose[:3].tolist()
+    cx, cy, cz = s.centre(top).tolist()
+    dx, dy, dz = cx - px, cy - py, cz - pz
+    lx, ly = dx * r0 + dy * r3 + dz * r6, dx * r1 + dy * r4 + dz * r7
     (x0, y0), (x1, y1) = info.footprint
-    if not (x0 <= local[0] <= x1 and y0 <= local[1] <= y1):
+    if not (x0 <= lx <= x1 and y0 <= ly <= y1):
         return False
-    surface = (pose @ np.array([local[0], local[1], info.top, 1.0]))[2]
+    surface = r6 * lx + r7 * ly + r8 * info.top + pz
     if abs(s.lowest(top) - surface) > ON_TOLERANCE:
         return False
     return s.geo.distance(s.frames(top), s.frames(base)) <= ON_TOLERANCE
