@@ -5,6 +5,8 @@ predicates) while every body its kept pairs must involve sleeps (``fsvla.monitor
 Here each built-in scenario runs the benchmark's ``reach`` and ``sweep`` motions with two
 monitors on one scene, one with the guards and one reading every contact; their force
 maxima, last-substep contacts and margins must be bit-identical at every control step.
+Both read contacts in Python (the guards belong to that reader); a third monitor on the
+native reader, where it can be built, must read the same numbers, bit for bit.
 """
 
 from __future__ import annotations
@@ -21,6 +23,8 @@ pytest.importorskip("sapien")
 import fsvla
 from fsvla.library import builtin_scenarios
 from fsvla.monitor import SafetyMonitor
+from fsvla.monitor import probe as probe_module
+from fsvla.monitor.native import native_library
 
 pytestmark = pytest.mark.sim
 STEPS = 130  # one reach cycle (6 s) and a little more
@@ -53,17 +57,27 @@ def _record_readings(monitor: SafetyMonitor, into: list) -> None:
 
 @pytest.mark.parametrize("motion", ["reach", "sweep"])
 @pytest.mark.parametrize("name", sorted(builtin_scenarios()))
-def test_guards_read_what_a_full_scan_reads(name, motion):
+def test_guards_read_what_a_full_scan_reads(name, motion, monkeypatch):
     env = fsvla.make(name, monitor=True)
     actions = _motions()[motion](env, STEPS)
+    library = native_library()
     env.reset()
-    guarded = env.monitor
+    monkeypatch.setattr(probe_module, "native_library", lambda: None)
+    guarded = env.monitor = SafetyMonitor(env.monitor_spec, env.built)  # the one the env drives
+    guarded.reset()
     full = SafetyMonitor(env.monitor_spec, env.built)
     full.probe.guards = False
     full.reset()
-    a, b = [], []
+    monkeypatch.setattr(probe_module, "native_library", lambda: library)
+    native = SafetyMonitor(env.monitor_spec, env.built) if library is not None else None
+    if native is not None:
+        assert native.probe.native and not guarded.probe.native
+        native.reset()
+    a, b, c = [], [], []
     _record_readings(guarded, a)
     _record_readings(full, b)
+    if native is not None:
+        _record_readings(native, c)
     scans = {guarded: 0, full: 0}
     for monitor in scans:
         scan = monitor.probe._scan
@@ -79,10 +93,13 @@ def test_guards_read_what_a_full_scan_reads(name, motion):
     def record_both():
         record()
         full.record_substep()
+        if native is not None:
+            native.record_substep()
 
     def end_both():
         report = end()
-        margins.append((report.margins, full.end_step().margins))
+        margins.append((report.margins, full.end_step().margins,
+                        native.end_step().margins if native is not None else report.margins))
         return report
 
     guarded.record_substep, guarded.end_step = record_both, end_both
@@ -91,6 +108,13 @@ def test_guards_read_what_a_full_scan_reads(name, motion):
     assert len(a) == len(b) == STEPS
     for step, (x, y) in enumerate(zip(a, b)):
         assert x == y, (name, motion, step)
-    for step, (x, y) in enumerate(margins, start=1):
+    for step, (x, y, z) in enumerate(margins, start=1):
         assert np.array_equal(x, y), (name, motion, step)
+        np.testing.assert_array_equal(z, x, err_msg=f"{name} {motion} step {step}")
     assert scans[guarded] <= scans[full]
+    for step, (x, z) in enumerate(zip(a, c)):  # the native reader's maxima and contacts
+        for ours, theirs in zip(z, x):
+            assert ours.keys() == theirs.keys(), (name, motion, step)
+            for key, value in theirs.items():
+                np.testing.assert_array_equal(ours[key], value,
+                                           err_msg=f"{name} {motion} step {step} {key}")

@@ -102,12 +102,13 @@ bool wants(const Entry *e0, const Entry *e1) {
   return (e0 && (e0->flags & kRobotPairs) && link1) || (e1 && (e1->flags & kRobotPairs) && link0);
 }
 
-// Mass centre (world) of a rigid body; a static body's pose origin.
+// Mass centre (world) of a rigid body; a static body's pose origin. In SAPIEN's pose
+// arithmetic, as the Python reader's entity_pose * cmass_local_pose computes it.
 Vec mass_centre(const void *component) {
   auto *actor = static_cast<const PhysxRigidBaseComponent *>(component)->getPxActor();
-  ::physx::PxTransform pose = actor->getGlobalPose();
+  sapien::Pose pose = sapien::PxTransformToPose(actor->getGlobalPose());
   if (auto *body = actor->is<::physx::PxRigidBody>()) {
-    pose = pose * body->getCMassLocalPose();
+    pose = pose * sapien::PxTransformToPose(body->getCMassLocalPose());
   }
   return {pose.p.x, pose.p.y, pose.p.z};
 }
