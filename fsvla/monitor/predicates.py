@@ -181,7 +181,7 @@ def _on(p: Predicate, s: Scope) -> bool:
     pose = s.root_pose(base)
     # the top's centre in the base's frame, in plain floats (numpy's per-call cost
     # dominates three-vectors; this runs every step for most success conditions)
-    (r0, r1, r2, px), (r3, r4, r5, py), (r6, r7, r8, pz) = pose[:3].tolist()
+    (r0, r1, _, px), (r3, r4, _, py), (r6, r7, r8, pz) = pose[:3].tolist()
     cx, cy, cz = s.centre(top).tolist()
     dx, dy, dz = cx - px, cy - py, cz - pz
     lx, ly = dx * r0 + dy * r3 + dz * r6, dx * r1 + dy * r4 + dz * r7
