@@ -43,6 +43,10 @@ SOURCE = Path(__file__).with_name("native") / "contacts.cpp"
 SWITCH = "FSVLA_NATIVE_CONTACTS"
 _ROWS = 64  # initial capacity of the row buffers; they grow when a reading needs more
 
+#: The capsule name pybind11's conduit expects: ``typeid(std::type_info).name()`` in the
+#: C++ runtime SAPIEN uses (libstdc++).
+TYPE_INFO_CAPSULE = b"St9type_info"
+
 # flags of a frame in a reader (contacts.cpp's Flags)
 ANY_PAIR, ROBOT_PAIRS, TORQUE, ROBOT_LINK = 1, 2, 4, 8
 
@@ -143,16 +147,13 @@ class NativeLibrary:
         self._capsule_new = _c_api("PyCapsule_New", ctypes.py_object, p, ctypes.c_char_p, p)  # a new reference
         self._capsule_name = _c_api("PyCapsule_GetName", ctypes.c_char_p, ctypes.py_object)
         self._capsule_pointer = _c_api("PyCapsule_GetPointer", p, ctypes.py_object, ctypes.c_char_p)
-        self._type_info_name = _type_info_capsule_name()
         self._abi_ids = _pybind_abi_ids()
 
     def pointer(self, obj: Any, type_info: int) -> int:
         """The C++ pointer behind a SAPIEN object, as the type ``type_info`` names."""
-        capsule = self._capsule_new(type_info, self._type_info_name, None)
-        for abi in self._abi_ids:
-            conduit = getattr(obj, "_pybind11_conduit_v1_", None)
-            if conduit is None:
-                break
+        conduit = getattr(obj, "_pybind11_conduit_v1_", None)
+        capsule = self._capsule_new(type_info, TYPE_INFO_CAPSULE, None)
+        for abi in self._abi_ids if conduit is not None else ():
             result = conduit(abi, capsule, b"raw_pointer_ephemeral")
             if result is not None:
                 return int(self._capsule_pointer(result, self._capsule_name(result)))
@@ -175,11 +176,6 @@ class NativeLibrary:
             buffer = ctypes.create_string_buffer(n + 1)
             self.lib.fsvla_entity_name(pointer, buffer, len(buffer))
         return buffer.value.decode("utf-8", "replace")
-
-
-def _type_info_capsule_name() -> bytes:
-    """``typeid(std::type_info).name()`` for the C++ runtime SAPIEN uses (libstdc++)."""
-    return b"St9type_info"
 
 
 def _c_api(name: str, restype: Any, *argtypes: Any) -> Any:
@@ -217,12 +213,13 @@ def native_library() -> NativeLibrary | None:
 
 
 class NativePoses:
-    """World poses of a fixed list of components, read in one call: the matrices SAPIEN's
+    """World poses of a fixed list of components (their pointers, as
+    :meth:`NativeLibrary.component` gives them), read in one call: the matrices SAPIEN's
     ``entity_pose.to_transformation_matrix()`` gives, bit for bit."""
 
-    def __init__(self, library: NativeLibrary, components: Sequence[Any]):
+    def __init__(self, library: NativeLibrary, pointers: Sequence[int]):
         self._poses = library.lib.fsvla_poses
-        self._pointers = np.array([library.component(c) for c in components], dtype=np.uint64)
+        self._pointers = np.array(pointers, dtype=np.uint64)
         self._address, self._n = self._pointers.ctypes.data, len(self._pointers)
 
     def read(self) -> np.ndarray:
@@ -244,19 +241,21 @@ class FreeBodySpec:
 
 class NativeReader:
     """One filter's reading over one scene: per-substep folds, maxima taken per control
-    step (:meth:`take`), or the current reports' pair impulses (:meth:`read`)."""
+    step (:meth:`take`), or the current reports' pair impulses (:meth:`read`).
 
-    def __init__(self, library: NativeLibrary, physx_system: Any, components: Mapping[str, Any], *,
+    ``system`` is :meth:`NativeLibrary.system`'s pointer, ``pointers`` every frame's
+    component pointer (:meth:`NativeLibrary.component`); free bodies are frames of it."""
+
+    def __init__(self, library: NativeLibrary, system: int, pointers: Mapping[str, int], *,
                  any_pair: Iterable[str] = (), robot_pairs: Iterable[str] = (), torque: Iterable[str] = (),
                  free_bodies: Sequence[FreeBodySpec] = ()):
         self._library, lib = library, library.lib
         self._lib = lib
-        self._handle = lib.fsvla_reader_new(library.system(physx_system))
+        self._handle = lib.fsvla_reader_new(system)
         any_pair, robot_pairs, torque = frozenset(any_pair), frozenset(robot_pairs), frozenset(torque)
         robots: dict[str, int] = {}
         self._frames: dict[int, str] = {}
-        for frame, component in components.items():
-            pointer = library.component(component)
+        for frame, pointer in pointers.items():
             flags = ((ANY_PAIR if frame in any_pair else 0) | (ROBOT_PAIRS if frame in robot_pairs else 0)
                      | (TORQUE if frame in torque else 0))
             robot = -1
@@ -271,7 +270,7 @@ class NativeReader:
             inertia = (ctypes.c_double * 3)(*(float(v) for v in c.inertia))
             cmass_q = (ctypes.c_double * 4)(*(float(v) for v in c.cmass_local_pose.q))
             gravity = (ctypes.c_double * 3)(*body.gravity)
-            lib.fsvla_reader_add_free(self._handle, library.component(c), int(body.torque), float(c.mass),
+            lib.fsvla_reader_add_free(self._handle, pointers[body.frame], int(body.torque), float(c.mass),
                                       inertia, cmass_q, gravity)
         self._free_values = np.zeros(2 * max(len(self._free), 1))
         self._free_arg = self._free_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))

@@ -216,13 +216,15 @@ class Probe:
         library = native_library()
         if library is None:
             return None, None, None
-        try:
+        try:  # the C++ pointers once, for all three
+            system = library.system(self._physx)
+            pointers = {f: library.component(c) for f, c in self.components.items()}
             free = [FreeBodySpec(b.frame, b.c, b.torque, gravity) for b in self._free]
-            scan = NativeReader(library, self._physx, self.components, any_pair=self._filter.any_pair,
+            scan = NativeReader(library, system, pointers, any_pair=self._filter.any_pair,
                                 robot_pairs=self._filter.robot_pairs, torque=self._torque, free_bodies=free)
-            last = NativeReader(library, self._physx, self.components, any_pair=self._last.any_pair,
+            last = NativeReader(library, system, pointers, any_pair=self._last.any_pair,
                                 robot_pairs=self._last.robot_pairs) if self._last else None
-            poses = NativePoses(library, self._pose_components) if self._pose_components else None
+            poses = NativePoses(library, [pointers[f] for f in self._pose_names]) if self._pose_names else None
         except NativeUnavailable as error:
             log.info("reading this scene's contacts in Python: %s", error)
             return None, None, None
@@ -252,10 +254,11 @@ class Probe:
         self.maxima.clear()
         self._scan_memo = self._last_memo = None
         self._scan_slept = self._last_slept = False
-        for body in self._free:
-            body.read()
         if self._native_scan is not None:
             self._native_scan.reset()
+        else:
+            for body in self._free:
+                body.read()
 
     def record_substep(self) -> None:
         """Fold the physics step just taken into the control step's maxima."""
