@@ -88,9 +88,10 @@ def _edge_clearance(ch: ChannelSpec, layout: Layout) -> Measure:
         pose = geo.pose(support.root_frame) if geo.has(support.root_frame) else np.eye(4)
         best = MAX_DISTANCE
         for frames in subjects:
-            points = geo.points(frames)
-            if len(points):  # in the support's frame, to its footprint's nearest edge
-                best = min(best, kernels.inside_margin(points, pose, x0, y0, x1, y1))
+            for frame in frames:
+                points = geo.local_points(frame)
+                if points is not None and len(points):  # in the support's frame, to its footprint's nearest edge
+                    best = min(best, kernels.inside_margin(points, geo.pose(frame), pose, x0, y0, x1, y1))
         memo[:] = [(geo, version, best)]
         return best
 

@@ -18,6 +18,7 @@ from fsvla.compiler.monitor import MonitorSpec
 from fsvla.compiler.scene import SceneSpec
 from fsvla.dsl.models import AllOf, AnyOf, Not, Predicate
 
+from . import kernels
 from .geometry import SceneGeometry
 from .layout import Layout
 from .predicates import CONTACT_PREDICATES
@@ -79,10 +80,10 @@ def predicate_filter(spec: MonitorSpec, layout: Layout) -> ContactFilter:
 class ContactGate:
     """Whether the per-substep scan and the predicates' contact reading can find anything
     in the next control step: robot-link pieces against body pieces within
-    :data:`CONTACT_GATE`, tested first on frame bounds (``SceneGeometry.frames_within``; a
-    frame's bounds hold its pieces', so far frames rule their pieces out) and on pieces
-    only where a frame is near. A filter that counts every contact of a non-robot frame
-    is never gated."""
+    :data:`CONTACT_GATE`, tested first on frame bounds (a frame's bounds hold its pieces',
+    so far frames rule their pieces out) and on pieces only where a frame is near, in one
+    compiled pass (``kernels.contact_gate``). A filter that counts every contact of a
+    non-robot frame is never gated."""
 
     def __init__(self, geometry: SceneGeometry, scan: ContactFilter, last: ContactFilter):
         self.geometry = geometry
@@ -93,58 +94,32 @@ class ContactGate:
         self.scan_always = bool(scan.any_pair - robot_any) or (bool(scan) and not len(ia))
         self.last_always = bool(last.any_pair) or (bool(last) and not len(ia))
         self.wants_scan, self.wants_last = bool(scan), bool(last)
-        # Frame level: the scan's robot rows against every body, and every robot link
-        # against the bodies the scan or the predicates watch.
+        # Frame level: every robot link against the bodies the scan or the predicates
+        # watch, and the robot links whose every contact counts against every body.
         index = geometry.frame_indices
-        self._rows_all, self._cols_all = index(self.rows), index(self.cols)
-        scan_rows = np.isin(self._rows_all, index(robot_any))
-        scan_cols = np.isin(self._cols_all, index(scan.robot_pairs)) & self.wants_scan
-        last_cols = np.isin(self._cols_all, index(last.robot_pairs)) & self.wants_last
-        self._scan_rows = self._rows_all[scan_rows] if self.wants_scan and scan_rows.any() else None
+        rows_all, cols_all = index(self.rows), index(self.cols)
+        scan_cols = np.isin(cols_all, index(scan.robot_pairs)) & self.wants_scan
+        last_cols = np.isin(cols_all, index(last.robot_pairs)) & self.wants_last
         cols = scan_cols | last_cols
-        self._cols = self._cols_all[cols]
-        self._scan_cols, self._last_cols = scan_cols[cols], last_cols[cols]
-        self._frames = self.rows | self.cols
-        # the piece-level test, run only where the frame-level one finds something near
-        piece_rows = np.isin(ia, geometry.pieces(robot_any))
-        self._piece_scan_cols = np.isin(ib, geometry.pieces(scan.robot_pairs)) & self.wants_scan
-        self._piece_last_cols = np.isin(ib, geometry.pieces(last.robot_pairs)) & self.wants_last
-        self._piece_rows = ia[piece_rows] if self.wants_scan and piece_rows.any() else None
-        self._ia, self._ib = ia, ib
+        scan_rows = rows_all[np.isin(rows_all, index(robot_any))] if self.wants_scan else rows_all[:0]
+        piece_scan_rows = ia[np.isin(ia, geometry.pieces(robot_any))] if self.wants_scan else ia[:0]
+        self._plan = (rows_all, cols_all[cols], scan_rows, scan_cols[cols], last_cols[cols], cols_all,
+                      ia, ib, piece_scan_rows,
+                      np.isin(ib, geometry.pieces(scan.robot_pairs)) & self.wants_scan,
+                      np.isin(ib, geometry.pieces(last.robot_pairs)) & self.wants_last)
         self._answer: tuple[int, tuple[bool, bool]] | None = None
-
-    def _pieces_near(self, check_scan: bool, check_last: bool) -> tuple[bool, bool]:
-        """The piece-level verdicts asked for (False for the others)."""
-        geometry, scan, last = self.geometry, False, False
-        if check_scan and self._piece_rows is not None:
-            scan = geometry.pieces_within(self._piece_rows, self._ib, CONTACT_GATE)
-        check_scan = check_scan and not scan
-        cols = (self._piece_scan_cols & check_scan) | (self._piece_last_cols & check_last)
-        if cols.any():
-            touched = geometry.piece_columns_within(self._ia, self._ib[cols], CONTACT_GATE)
-            scan = scan or (check_scan and bool((touched & self._piece_scan_cols[cols]).any()))
-            last = check_last and bool((touched & self._piece_last_cols[cols]).any())
-        return scan, last
 
     def update(self) -> tuple[bool, bool]:
         """(scan substeps, read the last substep's contacts) for the next control step."""
-        version = self.geometry.version(self._frames)
-        if self._answer is not None and self._answer[0] == version:
+        geometry = self.geometry
+        if self._answer is not None and self._answer[0] == geometry.moves:
             return self._answer[1]  # nothing moved
         scan, last = self.scan_always, self.last_always
-        if not (scan and last) and len(self._rows_all):
-            # frame bounds hold their pieces' bounds: far frames rule pieces out at once
-            geometry = self.geometry
-            touched = geometry.frame_columns_within(self._rows_all, self._cols, CONTACT_GATE)
-            maybe_scan = not scan and self.wants_scan and (
-                bool((touched & self._scan_cols).any())
-                or (self._scan_rows is not None
-                    and geometry.frames_within(self._scan_rows, self._cols_all, CONTACT_GATE)))
-            maybe_last = not last and self.wants_last and bool((touched & self._last_cols).any())
-            if maybe_scan or maybe_last:  # the same verdict as a piece-level gate
-                near_scan, near_last = self._pieces_near(maybe_scan, maybe_last)
-                scan, last = scan or near_scan, last or near_last
-        self._answer = (version, (scan, last))
+        check_scan, check_last = not scan and self.wants_scan, not last and self.wants_last
+        if (check_scan or check_last) and len(self._plan[0]):
+            verdict = kernels.contact_gate(*geometry.boxes, *self._plan, check_scan, check_last, CONTACT_GATE)
+            scan, last = scan or bool(verdict & 1), last or bool(verdict & 2)
+        self._answer = (geometry.moves, (scan, last))
         return scan, last
 
 

@@ -9,13 +9,18 @@ one compiled pass (``fsvla.monitor.kernels``); FCL transforms are set lazily, on
 pieces an exact query touches. :meth:`SceneGeometry.prefetch` gives each distance query
 of a step the gap between its groups' nearest frames, in one call; a query already that
 far answers with it. Otherwise :meth:`SceneGeometry.distance` visits the piece pairs of
-two groups in order of their bounds' gap and stops once that gap exceeds the best exact
-distance found (or, overlapping pieces found, once bounds stop overlapping: the deepest
-penetration), so the minimum is exact while far pairs cost nothing. Given
-``exact_below`` it also stops once the gap reaches that value: the answer is then a
-lower bound no smaller than ``exact_below`` (channels pass their limit plus soft
-threshold plus ``EXACT_BAND``, so states and costs stay exact). Results are memoised
-until a frame of either group moves by more than ``POSE_TOLERANCE``.
+two groups in order of a lower bound of their signed distance and stops once that bound
+exceeds the best exact distance found, so the minimum is exact while far pairs cost
+nothing. A pair's bound is the larger of its boxes' gap (where they are apart) and the
+bound *carried* from the group's last exact pass: the exact distance found then, less
+how far each of the two pieces can have moved since (``kernels.carry_bounds``); a pair
+neither of whose pieces moved keeps its exact distance. While a carried object passes a
+protected one a step moves it a centimetre, so slanted pieces whose boxes overlap but
+which were centimetres apart need no new FCL query. Given ``exact_below`` the search
+also stops once the bounds reach that value: the answer is then a lower bound no
+smaller than ``exact_below`` (channels pass their limit plus soft threshold plus
+``EXACT_BAND``, so states and costs stay exact). Results are memoised until a frame of
+either group moves by more than ``POSE_TOLERANCE``.
 """
 
 from __future__ import annotations
@@ -48,6 +53,8 @@ MAX_DISTANCE = 10.0
 #: A frame is re-posed only when an entry of its 4x4 pose changed by more than this
 #: (10 µm, ~1e-5 rad): PhysX jitters resting bodies by about 1e-6.
 POSE_TOLERANCE = 1e-5
+#: An exact FCL distance carried as a bound loses this much (m): FCL finds distances to 1e-6.
+CARRY_SLACK = 1e-5
 _POINT_SECTIONS = 12  # rim points of a round shape for footprint / lowest-point queries
 
 # SAPIEN capsules and cylinders lie along local x; ours (and FCL's) along local z.
@@ -122,14 +129,16 @@ class SceneGeometry:
         self._groups: dict[frozenset[str], NDArray[np.int64]] = {}
         self._memo: dict[tuple[frozenset[str], frozenset[str]], tuple[float, float, int]] = {}
         self._pairs: dict[tuple[frozenset[str], frozenset[str]], tuple] = {}
+        # per query: lower bounds of its piece pairs' distances, which are exact, the poses they hold at
+        self._carried: dict[tuple[frozenset[str], frozenset[str]], tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]] = {}
         self._batches: dict[tuple, tuple] = {}
-        self._bounds_memo: dict[frozenset[str], tuple[int, tuple[NDArray[np.float64], NDArray[np.float64]]]] = {}
+        self._bound_rows: dict[frozenset[str], NDArray[np.int64]] = {}  # frame-bound rows of a group
         self._prefetched: dict[tuple[frozenset[str], frozenset[str]], tuple[int, float]] = {}
         self._moves_made = 0  # times set_poses moved a frame: the prefetch is current while equal
         self._prefetched_at = -1
+        self._prefetched_for: tuple | None = None
         self._moves: dict[tuple[str, ...], tuple[list[int], NDArray[np.int64]]] = {}
         self._group_frames: dict[frozenset[str], NDArray[np.int64]] = {}
-        self._point_memo: dict[frozenset[str], tuple[int, NDArray[np.float64]]] = {}
         self._frame_points: dict[str, NDArray[np.float64]] = {}
         self._frozen = False
 
@@ -164,11 +173,13 @@ class SceneGeometry:
         self._frozen = False
 
     def _freeze(self) -> None:
+        kernels.warm_up()
         if hasattr(self, "_pose_array"):  # frames added after queries keep the others' poses
             for i, pose in enumerate(self._pose_array):
                 self._poses[i] = pose
         self._c = np.array(self._centres, dtype=np.float64).reshape(-1, 3)
         self._h = np.array(self._halves, dtype=np.float64).reshape(-1, 3)
+        self._radius = np.sqrt((self._h ** 2).sum(axis=1))  # a piece lies within this of its box's centre
         self._pf = np.array(self._piece_frame, dtype=np.int64)
         self._pose_array = np.array(self._poses, dtype=np.float64).reshape(-1, 4, 4)
         self._plo, self._phi = np.zeros_like(self._c), np.zeros_like(self._c)
@@ -176,11 +187,12 @@ class SceneGeometry:
         self._moves.clear()
         self._group_frames.clear()
         self._memo.clear()
+        self._carried.clear()
         self._pairs.clear()
         self._batches.clear()
         self._prefetched.clear()
-        self._bounds_memo.clear()
-        self._point_memo.clear()
+        self._prefetched_for = None
+        self._bound_rows.clear()
         self._stamp = np.array(self._stamp, dtype=np.int64)
         # the frames with pieces, in frame order, are the rows of the frame bounds
         counts = np.bincount(self._pf, minlength=len(self.frames))
@@ -192,6 +204,7 @@ class SceneGeometry:
         self._frame_points = {f: np.concatenate([self._points[i] for i in idx]) for f, idx in self._frame_pieces.items()
                               if idx}
         self._update_bounds()
+        self._moves_made += 1  # every bound may have changed
         self._frozen = True
 
     def has(self, frame: str) -> bool:
@@ -224,9 +237,9 @@ class SceneGeometry:
             stack = np.array(values if keep is None else [values[i] for i in keep], dtype=np.float64)
         elif keep is not None:
             stack = stack[keep]
-        if kernels.apply_poses(stack, frames, self._pose_array, self._stamp, POSE_TOLERANCE):
-            self._moves_made += 1
-            self._update_bounds()
+        if kernels.move_frames(stack, frames, self._pose_array, self._stamp, POSE_TOLERANCE, self._pf, self._c,
+                               self._h, self._piece_row, self._plo, self._phi, self._flo, self._fhi):
+            self._moves_made += 1  # and the bounds are updated
 
     def _update_bounds(self) -> None:
         """Every piece's and every frame's world bounds (one pass over all pieces is cheaper
@@ -293,30 +306,26 @@ class SceneGeometry:
         keys, frames, frame_starts, rows_a, rows_b, starts = plan
         if not keys:
             return
-        versions = np.add.reduceat(self._stamp[frames], frame_starts).tolist()
-        nearest = np.empty(len(keys))
-        kernels.nearest_per_query(self._flo, self._fhi, rows_a, rows_b, starts, nearest)
-        self._prefetched = dict(zip(keys, zip(versions, nearest.tolist())))
-        self._prefetched_at = self._moves_made
+        if self._prefetched_at == self._moves_made and self._prefetched_for is queries:
+            return  # nothing moved since these were fetched
+        nearest, versions = np.empty(len(keys)), np.empty(len(keys), dtype=np.int64)
+        kernels.nearest_per_query(self._flo, self._fhi, rows_a, rows_b, starts, nearest, self._stamp, frames,
+                                  frame_starts, versions)
+        self._prefetched = dict(zip(keys, zip(versions.tolist(), nearest.tolist())))
+        self._prefetched_at, self._prefetched_for = self._moves_made, queries
 
-    def frames_within(self, rows: NDArray[np.int64], cols: NDArray[np.int64], gap: float) -> bool:
-        """Whether the world bounds of a frame of ``rows`` and one of ``cols`` (rows of
-        :meth:`frame_indices`) are apart by less than ``gap`` on every axis."""
-        return bool(kernels.any_within(self._flo, self._fhi, rows, cols, gap))
+    @property
+    def moves(self) -> int:
+        """How many times :meth:`set_poses` moved a frame: while it is unchanged, nothing moved."""
+        return self._moves_made
 
-    def frame_columns_within(self, rows: NDArray[np.int64], cols: NDArray[np.int64],
-                             gap: float) -> NDArray[np.bool_]:
-        """Per frame of ``cols``: :meth:`frames_within` of it and ``rows``."""
-        return kernels.columns_within(self._flo, self._fhi, rows, cols, gap)
-
-    def pieces_within(self, ia: NDArray[np.int64], ib: NDArray[np.int64], gap: float) -> bool:
-        """:meth:`frames_within` for pieces (indices as :meth:`pieces` gives them)."""
-        return bool(kernels.any_within(self._plo, self._phi, ia, ib, gap))
-
-    def piece_columns_within(self, ia: NDArray[np.int64], ib: NDArray[np.int64],
-                             gap: float) -> NDArray[np.bool_]:
-        """:meth:`frame_columns_within` for pieces."""
-        return kernels.columns_within(self._plo, self._phi, ia, ib, gap)
+    @property
+    def boxes(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """World bounds (lower, upper) of the frames (rows of :meth:`frame_indices`), then of
+        the pieces (as :meth:`pieces` numbers them); updated in place as frames move."""
+        if not self._frozen:
+            self._freeze()
+        return self._flo, self._fhi, self._plo, self._phi
 
     def frame_indices(self, frames: Iterable[str]) -> NDArray[np.int64]:
         """Rows of the frame bounds for those of ``frames`` that have pieces (sorted)."""
@@ -356,7 +365,7 @@ class SceneGeometry:
         if not self._frozen:
             self._freeze()
         key = (a, b)
-        ia, ib, frames, same = self._pair(a, b)
+        ia, ib, frames, _ = self._pair(a, b)
         found = self._prefetched.get(key)
         if found is not None and self._prefetched_at == self._moves_made:
             version = found[0]  # nothing moved since the prefetch summed these stamps
@@ -370,71 +379,67 @@ class SceneGeometry:
         if found is not None and found[1] >= exact_below:
             self._memo[key] = (found[1], exact_below, version)  # far at the frame level already
             return found[1]
-        bound = np.empty(len(ia) * len(ib))
-        kernels.pair_distances(self._plo, self._phi, ia, ib, bound)
-        nearest = float(bound.min())
-        if nearest >= exact_below:  # every pair is far: the broad phase answers
-            self._memo[key] = (nearest, exact_below, version)
-            return nearest
+        lower, known, order, n, beyond = self._carry(key, ia, ib, exact_below)
+        if n == 0:  # every pair is far: the bounds answer
+            beyond = min(beyond, MAX_DISTANCE)
+            self._memo[key] = (beyond, exact_below, version)
+            return beyond
         best = MAX_DISTANCE
         nb = len(ib)
-        # Only pairs whose bounds are below exact_below can matter: sort just those.
-        candidates = np.flatnonzero(bound < exact_below)
-        candidates = candidates[np.argsort(bound[candidates], kind="stable")]
-        lowers = bound[candidates].tolist()
-        skip = same[candidates].tolist()
-        for flat, lower, same_frame in zip(candidates.tolist(), lowers, skip):
-            # a pair whose bounds are apart is at least that far; overlapping bounds
-            # (lower = 0) can still hold a deeper penetration than a negative best
-            if lower >= best and (best >= 0.0 or lower > 0.0):
+        for flat in order[:n].tolist():  # the pairs whose bounds are below exact_below, nearest first
+            bound = float(lower[flat])
+            if bound >= best:  # this pair and the rest are at least that far
                 break
-            if same_frame:
-                continue
-            best = min(best, signed_distance(self._fcl(ia[flat // nb]).obj, self._fcl(ib[flat % nb]).obj))
+            if not known[flat]:
+                bound = signed_distance(self._fcl(ia[flat // nb]).obj, self._fcl(ib[flat % nb]).obj)
+                lower[flat], known[flat] = bound, True
+            best = min(best, bound)
         else:  # the pairs left are at least as far as the nearest of their bounds
-            if len(candidates) < len(bound):
-                best = min(best, float(bound[bound >= exact_below].min()))
+            best = min(best, beyond)
         self._memo[key] = (best, exact_below, version)
         return best
+
+    def _carry(self, key: tuple[frozenset[str], frozenset[str]], ia: NDArray[np.int64], ib: NDArray[np.int64],
+               below: float) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.int64], int, float]:
+        """Lower bounds of the signed distance of every piece pair of a query (a * b, row-major)
+        and whether each is exact: what the last exact pass found, less how far the pieces
+        moved since (``kernels.carry_bounds``), or their boxes' gap where that is larger.
+        Then the pairs whose bound is below ``below``, nearest first (``order[:n]``), and the
+        smallest bound of the others."""
+        carried = self._carried.get(key)
+        if carried is None:
+            same = self._pair(*key)[3]  # pieces of one frame in both groups are never compared
+            carried = self._carried[key] = (np.where(same, np.inf, -np.inf), same.copy(), self._pose_array.copy(),
+                                            np.zeros(len(same), dtype=np.int64))
+        lower, known, ref, order = carried
+        n, beyond = kernels.carry_bounds(self._pose_array, ref, self._pf, self._c, self._radius, self._plo,
+                                         self._phi, ia, ib, lower, known, CARRY_SLACK, below, order)
+        return lower, known, order, n, beyond
 
     def pieces(self, frames: frozenset[str]) -> NDArray[np.int64]:
         """Indices of the frames' pieces (sorted), as the rows/columns of :meth:`near`."""
         return self._group(frames)
 
-    def points(self, frames: frozenset[str]) -> NDArray[np.float64]:
-        """World sample points of the frames' geometry (vertices, rims of round shapes)."""
+    def local_points(self, frame: str) -> NDArray[np.float64] | None:
+        """Sample points of the frame's geometry in its own coordinates (the vertices of its
+        pieces, the rims of round shapes), or None for a frame without geometry."""
         if not self._frozen:
             self._freeze()
-        version = self.version(frames)
-        cached = self._point_memo.get(frames)
-        if cached is not None and cached[0] == version:
-            return cached[1]
-        chunks = []
-        for frame in frames:
-            index = self._frame_index.get(frame)
-            if index is None:
-                continue
-            pose = self._pose_array[index]
-            if frame in self._frame_points:
-                chunks.append(self._frame_points[frame] @ pose[:3, :3].T + pose[:3, 3])
-        points = np.concatenate(chunks) if chunks else np.zeros((0, 3))
-        self._point_memo[frames] = (version, points)
-        return points
+        return self._frame_points.get(frame)
 
     def bounds(self, frames: frozenset[str]) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-        """World axis-aligned bounds (lower, upper) of the frames' pieces, or None."""
+        """World axis-aligned bounds (lower, upper) of the frames' pieces, or None: taken
+        from the frame bounds :meth:`set_poses` keeps (a frame's box holds its pieces')."""
         if not self._frozen:
             self._freeze()
-        idx = self._group(frames)
-        if len(idx) == 0:
+        rows = self._bound_rows.get(frames)
+        if rows is None:
+            rows = self._bound_rows[frames] = self.frame_indices(frames)
+        if len(rows) == 1:
+            r = rows[0]
+            return self._flo[r].copy(), self._fhi[r].copy()
+        if len(rows) == 0:
             return None
-        version = self.version(frames)
-        cached = self._bounds_memo.get(frames)
-        if cached is not None and cached[0] == version:
-            return cached[1]
-        found = self._plo[idx].min(axis=0), self._phi[idx].max(axis=0)
-        self._bounds_memo[frames] = (version, found)
-        return found
-
+        return self._flo[rows].min(axis=0), self._fhi[rows].max(axis=0)
 
 __all__ = ["MAX_DISTANCE", "POSE_TOLERANCE", "SceneGeometry", "shapes_of_sapien"]

@@ -13,6 +13,7 @@ lower bound of the distance between anything inside them.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -68,6 +69,19 @@ def update_bounds(poses: NDArray[np.float64], piece_frame: NDArray[np.int64],
             fhi[r, i] = max(fhi[r, i], hi)
 
 
+@njit(cache=True, nogil=True)
+def move_frames(stack: NDArray, frames: NDArray[np.int64], poses: NDArray[np.float64],
+                stamp: NDArray[np.int64], tolerance: float, piece_frame: NDArray[np.int64],
+                centre: NDArray[np.float64], half: NDArray[np.float64], piece_row: NDArray[np.int64],
+                plo: NDArray[np.float64], phi: NDArray[np.float64], flo: NDArray[np.float64],
+                fhi: NDArray[np.float64]) -> int:
+    """:func:`apply_poses`, then, if a frame moved, :func:`update_bounds`: one call a step."""
+    moved = apply_poses(stack, frames, poses, stamp, tolerance)
+    if moved and piece_frame.shape[0]:
+        update_bounds(poses, piece_frame, centre, half, piece_row, plo, phi, flo, fhi)
+    return moved
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _distance(lo: NDArray[np.float64], hi: NDArray[np.float64], a: int, b: int) -> float:
     total = 0.0
@@ -88,9 +102,12 @@ def _within(lo: NDArray[np.float64], hi: NDArray[np.float64], a: int, b: int, ga
 
 @njit(cache=True, nogil=True)
 def nearest_per_query(lo: NDArray[np.float64], hi: NDArray[np.float64], a: NDArray[np.int64],
-                      b: NDArray[np.int64], starts: NDArray[np.int64], out: NDArray[np.float64]) -> None:
+                      b: NDArray[np.int64], starts: NDArray[np.int64], out: NDArray[np.float64],
+                      stamp: NDArray[np.int64], frames: NDArray[np.int64], frame_starts: NDArray[np.int64],
+                      versions: NDArray[np.int64]) -> None:
     """``out[q]``: the smallest distance of the box pairs ``(a[k], b[k])`` for k from
-    ``starts[q]`` up to the next query's start (or the end)."""
+    ``starts[q]`` up to the next query's start (or the end); ``versions[q]``: the sum of
+    ``stamp`` over ``frames`` from ``frame_starts[q]`` up to the next query's."""
     n = starts.shape[0]
     for q in range(n):
         end = starts[q + 1] if q + 1 < n else a.shape[0]
@@ -98,16 +115,86 @@ def nearest_per_query(lo: NDArray[np.float64], hi: NDArray[np.float64], a: NDArr
         for k in range(starts[q], end):
             best = min(best, _distance(lo, hi, a[k], b[k]))
         out[q] = best
+        end = frame_starts[q + 1] if q + 1 < n else frames.shape[0]
+        total = 0
+        for k in range(frame_starts[q], end):
+            total += stamp[frames[k]]
+        versions[q] = total
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _moved(now: NDArray[np.float64], then: NDArray[np.float64], centre: NDArray[np.float64],
+           radius: float) -> float:
+    """How far any point within ``radius`` of ``centre`` (frame coordinates) can have moved
+    when its frame went from pose ``then`` to pose ``now``: the centre's displacement plus
+    ``radius`` times the spectral norm of the rotation's change, ``2 sin(θ/2)``, which is
+    ``sqrt(Σ ΔR_ij² / 2)`` for two rotations."""
+    shift = 0.0
+    turn = 0.0
+    for i in range(3):
+        d = now[i, 3] - then[i, 3]
+        for j in range(3):
+            r = now[i, j] - then[i, j]
+            d += r * centre[j]
+            turn += r * r
+        shift += d * d
+    return math.sqrt(shift) + radius * math.sqrt(0.5 * turn)
 
 
 @njit(cache=True, nogil=True)
-def pair_distances(lo: NDArray[np.float64], hi: NDArray[np.float64], a: NDArray[np.int64],
-                   b: NDArray[np.int64], out: NDArray[np.float64]) -> None:
-    """``out[i * len(b) + j]``: the distance of boxes ``a[i]`` and ``b[j]``."""
-    nb = b.shape[0]
-    for i in range(a.shape[0]):
+def _pieces_moved(poses: NDArray[np.float64], ref: NDArray[np.float64], piece_frame: NDArray[np.int64],
+                  centre: NDArray[np.float64], radius: NDArray[np.float64],
+                  pieces: NDArray[np.int64]) -> NDArray[np.float64]:
+    """:func:`_moved` of each of ``pieces`` between its frame's poses in ``ref`` and ``poses``."""
+    out = np.empty(pieces.shape[0])
+    for i in range(pieces.shape[0]):
+        p = pieces[i]
+        out[i] = _moved(poses[piece_frame[p]], ref[piece_frame[p]], centre[p], radius[p])
+    return out
+
+
+@njit(cache=True, nogil=True)
+def carry_bounds(poses: NDArray[np.float64], ref: NDArray[np.float64], piece_frame: NDArray[np.int64],
+                 centre: NDArray[np.float64], radius: NDArray[np.float64], lo: NDArray[np.float64],
+                 hi: NDArray[np.float64], a: NDArray[np.int64], b: NDArray[np.int64],
+                 lower: NDArray[np.float64], known: NDArray[np.bool_], slack: float, below: float,
+                 order: NDArray[np.int64]) -> tuple[int, float]:
+    """Bring the lower bounds ``lower[i * len(b) + j]`` of the signed distances of pieces
+    ``a[i]`` and ``b[j]`` from frame poses ``ref`` to ``poses``, then set ``ref`` to them.
+
+    A pair whose distance is ``known`` exactly keeps it while neither piece moved. Else a
+    distance cannot have shrunk by more than how far the two pieces moved (signed distance
+    is 1-Lipschitz in the motion of either set, penetrations included); an exact value
+    becoming a bound also loses ``slack`` (FCL's own tolerance). Where two pieces' boxes
+    are apart, their gap is a bound too: the larger one is kept.
+
+    Returns ``(n, beyond)``: ``order[:n]`` are the pairs whose bound is below ``below``,
+    nearest first, and ``beyond`` the smallest bound of the others (infinity if none)."""
+    na, nb = a.shape[0], b.shape[0]
+    moved_a = _pieces_moved(poses, ref, piece_frame, centre, radius, a)
+    moved_b = _pieces_moved(poses, ref, piece_frame, centre, radius, b)
+    n, beyond = 0, np.inf
+    for i in range(na):
         for j in range(nb):
-            out[i * nb + j] = _distance(lo, hi, a[i], b[j])
+            k = i * nb + j
+            moved = moved_a[i] + moved_b[j]
+            if moved > 0.0 or not known[k]:
+                carried = lower[k] - moved
+                if known[k]:
+                    carried -= slack
+                    known[k] = False
+                gap = _distance(lo, hi, a[i], b[j])
+                lower[k] = max(gap, carried) if gap > 0.0 else carried
+            if lower[k] < below:
+                order[n] = k
+                n += 1
+            else:
+                beyond = min(beyond, lower[k])
+    ref[:] = poses
+    if n > 1:
+        near = order[:n].copy()
+        order[:n] = near[np.argsort(lower[near], kind="mergesort")]
+    return n, beyond
 
 
 @njit(cache=True, nogil=True)
@@ -122,32 +209,78 @@ def any_within(lo: NDArray[np.float64], hi: NDArray[np.float64], a: NDArray[np.i
 
 
 @njit(cache=True, nogil=True)
-def columns_within(lo: NDArray[np.float64], hi: NDArray[np.float64], a: NDArray[np.int64],
-                   b: NDArray[np.int64], gap: float) -> NDArray[np.bool_]:
-    """Per box of ``b``: whether some box of ``a`` has every axis' gap to it below ``gap``."""
-    out = np.zeros(b.shape[0], dtype=np.bool_)
-    for j in range(b.shape[0]):
-        for i in range(a.shape[0]):
-            if _within(lo, hi, a[i], b[j], gap):
-                out[j] = True
-                break
-    return out
+def _any_column(lo: NDArray[np.float64], hi: NDArray[np.float64], rows: NDArray[np.int64],
+                cols: NDArray[np.int64], wanted: NDArray[np.bool_], gap: float) -> bool:
+    """Whether a box of ``rows`` is within ``gap`` of a box ``cols[j]`` with ``wanted[j]``."""
+    for j in range(cols.shape[0]):
+        if wanted[j]:
+            for i in range(rows.shape[0]):
+                if _within(lo, hi, rows[i], cols[j], gap):
+                    return True
+    return False
 
 
 @njit(cache=True, nogil=True)
-def inside_margin(points: NDArray[np.float64], pose: NDArray[np.float64], x0: float, y0: float,
-                  x1: float, y1: float) -> float:
-    """The smallest distance, in the xy-plane of ``pose``'s frame, from a point of ``points``
-    (world) to the edges of the rectangle [x0, x1] × [y0, y1] there: negative for a point
-    outside it; infinity for no points."""
+def contact_gate(flo: NDArray[np.float64], fhi: NDArray[np.float64], plo: NDArray[np.float64],
+                 phi: NDArray[np.float64], frame_rows: NDArray[np.int64], frame_cols: NDArray[np.int64],
+                 frame_scan_rows: NDArray[np.int64], frame_scan_cols: NDArray[np.bool_],
+                 frame_last_cols: NDArray[np.bool_], all_cols: NDArray[np.int64],
+                 piece_rows: NDArray[np.int64], piece_cols: NDArray[np.int64],
+                 piece_scan_rows: NDArray[np.int64], piece_scan_cols: NDArray[np.bool_],
+                 piece_last_cols: NDArray[np.bool_], check_scan: bool, check_last: bool, gap: float) -> int:
+    """The contact gate's verdict in one pass (bit 1: scan; bit 2: read the last substep).
+
+    A scan may find something when a robot frame of ``frame_rows`` is within ``gap`` of a
+    body frame the scan watches (``frame_cols`` where ``frame_scan_cols``), or a robot frame
+    whose every contact counts (``frame_scan_rows``) is near any body (``all_cols``); the
+    last-substep reading likewise for ``frame_last_cols``. Frame boxes hold their pieces'
+    boxes, so only where a frame pair is near are pieces compared, the same way."""
+    scan = check_scan and (_any_column(flo, fhi, frame_rows, frame_cols, frame_scan_cols, gap)
+                           or any_within(flo, fhi, frame_scan_rows, all_cols, gap))
+    last = check_last and _any_column(flo, fhi, frame_rows, frame_cols, frame_last_cols, gap)
+    if scan:
+        scan = (any_within(plo, phi, piece_scan_rows, piece_cols, gap)
+                or _any_column(plo, phi, piece_rows, piece_cols, piece_scan_cols, gap))
+    if last:
+        last = _any_column(plo, phi, piece_rows, piece_cols, piece_last_cols, gap)
+    return int(scan) | 2 * int(last)
+
+
+@njit(cache=True, nogil=True)
+def inside_margin(points: NDArray[np.float64], frame: NDArray[np.float64], support: NDArray[np.float64],
+                  x0: float, y0: float, x1: float, y1: float) -> float:
+    """The smallest distance, in the xy-plane of the ``support`` pose's frame, from a point
+    of ``points`` (in the coordinates of the ``frame`` pose) to the edges of the rectangle
+    [x0, x1] × [y0, y1] there: negative for a point outside it; infinity for no points."""
     best = np.inf
     for k in range(points.shape[0]):
-        dx, dy, dz = points[k, 0] - pose[0, 3], points[k, 1] - pose[1, 3], points[k, 2] - pose[2, 3]
-        x = dx * pose[0, 0] + dy * pose[1, 0] + dz * pose[2, 0]
-        y = dx * pose[0, 1] + dy * pose[1, 1] + dz * pose[2, 1]
+        px, py, pz = points[k, 0], points[k, 1], points[k, 2]
+        dx = frame[0, 0] * px + frame[0, 1] * py + frame[0, 2] * pz + frame[0, 3] - support[0, 3]
+        dy = frame[1, 0] * px + frame[1, 1] * py + frame[1, 2] * pz + frame[1, 3] - support[1, 3]
+        dz = frame[2, 0] * px + frame[2, 1] * py + frame[2, 2] * pz + frame[2, 3] - support[2, 3]
+        x = dx * support[0, 0] + dy * support[1, 0] + dz * support[2, 0]
+        y = dx * support[0, 1] + dy * support[1, 1] + dz * support[2, 1]
         best = min(best, x - x0, x1 - x, y - y0, y1 - y)
     return best
 
 
-__all__ = ["any_within", "apply_poses", "columns_within", "inside_margin", "nearest_per_query", "pair_distances",
-           "update_bounds"]
+@functools.cache
+def warm_up() -> None:
+    """Load every kernel now (from numba's disk cache, compiling on a first run), so that
+    the first control step that needs one does not pay for it: a cold load costs ms."""
+    poses, boxes, rows = np.tile(np.eye(4), (2, 1, 1)), np.zeros((2, 3)), np.zeros(2, dtype=np.int64)
+    flags, values = np.zeros(2, dtype=np.bool_), np.zeros(2)
+    for stack in (poses.astype(np.float32), poses.copy()):  # the native reader's poses, the Python one's
+        move_frames(stack, rows, poses.copy(), rows.copy(), 1e-5, rows, boxes, boxes, rows, boxes.copy(),
+                    boxes.copy(), boxes.copy(), boxes.copy())
+    update_bounds(poses, rows, boxes, boxes, rows, boxes.copy(), boxes.copy(), boxes.copy(), boxes.copy())
+    nearest_per_query(boxes, boxes, rows, rows, rows[:1], values[:1].copy(), rows, rows, rows[:1], rows[:1].copy())
+    carry_bounds(poses, poses.copy(), rows, boxes, values, boxes, boxes, rows, rows, np.zeros(4),
+                 np.zeros(4, dtype=np.bool_), 1e-5, 1.0, np.zeros(4, dtype=np.int64))
+    contact_gate(boxes, boxes, boxes, boxes, rows, rows, rows, flags, flags, rows, rows, rows, rows, flags, flags,
+                 True, True, 0.1)
+    inside_margin(boxes, poses[0], poses[1], 0.0, 0.0, 1.0, 1.0)
+
+
+__all__ = ["any_within", "apply_poses", "carry_bounds", "contact_gate", "inside_margin", "move_frames", "nearest_per_query",
+           "update_bounds", "warm_up"]

@@ -28,7 +28,7 @@ import re
 import shutil
 import subprocess
 import tempfile
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -299,9 +299,10 @@ class NativeReader:
         """Forget the maxima and re-read the free bodies' velocities."""
         self._lib.fsvla_reader_reset(self._handle)
 
-    def fold(self, inv_dt: float, scan: bool) -> None:
-        """Fold the substep just taken: free bodies, and the kept pairs if ``scan``."""
-        self._lib.fsvla_reader_fold(self._handle, inv_dt, scan)
+    def folder(self, inv_dt: float, scan: bool) -> Callable[[], None]:
+        """A callable that folds the substep just taken: free bodies, and the kept pairs if
+        ``scan`` (the reader's call with its arguments bound: it runs every substep)."""
+        return functools.partial(self._lib.fsvla_reader_fold, self._handle, inv_dt, scan)
 
     def take(self, maxima: ContactMaxima, clear: bool = True) -> None:
         """Add the maxima folded since the last take to ``maxima``, then forget them
@@ -333,15 +334,13 @@ class NativeReader:
         """Force on the first frame by the second, both orders, for the kept pairs of the
         current reports (the last substep)."""
         n = self._call(self._lib.fsvla_reader_read)
-        forces: dict[tuple[str, str], np.ndarray] = {}
         if not n:
-            return forces
-        pairs, impulses = self._pairs[:2 * n].tolist(), self._values[:3 * n] * inv_dt
-        for i in range(n):  # one row a component pair, and a frame is one component
-            a, b = self.frame(pairs[2 * i]), self.frame(pairs[2 * i + 1])
-            forces[(a, b)] = impulses[3 * i:3 * i + 3].copy()
-            forces[(b, a)] = -impulses[3 * i:3 * i + 3]
-        return forces
+            return {}
+        pairs = self._pairs[:2 * n].tolist()
+        on_first = self._values[:3 * n].reshape(n, 3) * inv_dt
+        keys = [(self.frame(pairs[2 * i]), self.frame(pairs[2 * i + 1])) for i in range(n)]
+        # one row a component pair, and a frame is one component; the values are rows of one array
+        return dict(zip(keys + [(b, a) for a, b in keys], np.concatenate((on_first, -on_first))))
 
     def _call(self, function: Any, *args: Any) -> int:
         n = function(self._handle, self._pairs_arg, self._values_arg, self._rows, *args)

@@ -26,7 +26,8 @@ pressed    the grippers push the object down (force z < -PRESS_FORCE) in the las
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Hashable, Mapping
 from functools import cache
 
 import numpy as np
@@ -51,18 +52,23 @@ CONTACT_PREDICATES = frozenset({"grasped", "released", "touching", "pressed"})
 
 
 class Scope:
-    """What a predicate reads: the state, the layout and the posed geometry."""
+    """What a predicate reads: the state, the layout and the posed geometry. ``slots``
+    (:func:`predicate_slots`) lets predicates that say the same thing share one answer."""
 
-    def __init__(self, state: WorldState, layout: Layout, geometry: SceneGeometry):
+    def __init__(self, state: WorldState, layout: Layout, geometry: SceneGeometry,
+                 slots: Mapping[int, Hashable] | None = None):
         self.state, self.layout, self.geo = state, layout, geometry
-        self.held: dict[int, tuple[Predicate, bool]] = {}  # id(predicate) -> (it, holds): one state, one answer
-        self._centres: dict[str, np.ndarray] = {}
+        self.slots = {} if slots is None else slots
+        self.held: dict[Hashable, bool] = {}  # a predicate's slot (else its id) -> holds: one state, one answer
+        self._centres: dict[str, tuple[float, float, float]] = {}
+        self._lowest: dict[str, float] = {}
 
     def frames(self, name: str) -> frozenset[str]:
         return self.layout.frames(name)
 
     def pose(self, frame: str) -> np.ndarray:
-        return self.state.poses[frame] if frame in self.state.poses else self.geo.pose(frame)
+        found = self.state.poses.get(frame)
+        return self.geo.pose(frame) if found is None else found
 
     def root_pose(self, body: str) -> np.ndarray:
         return self.pose(self.layout.bodies[body].root_frame)
@@ -72,25 +78,33 @@ class Scope:
             return self.state.touching(a, b)
         return self.geo.distance(a, b) <= TOUCH_DISTANCE
 
-    def centre(self, body: str) -> np.ndarray:
+    def centre(self, body: str) -> tuple[float, float, float]:
+        """The world centre of the body's bounds (plain floats: numpy's per-call cost
+        dominates three-vectors, and predicates read this every step)."""
         found = self._centres.get(body)
         if found is None:
-            pose = self.root_pose(body)
-            found = self._centres[body] = pose[:3, :3] @ self.layout.bodies[body].centre + pose[:3, 3]
+            (r0, r1, r2, px), (r3, r4, r5, py), (r6, r7, r8, pz) = self.root_pose(body)[:3].tolist()
+            x, y, z = self.layout.bodies[body].centre.tolist()
+            found = self._centres[body] = (r0 * x + r1 * y + r2 * z + px, r3 * x + r4 * y + r5 * z + py,
+                                           r6 * x + r7 * y + r8 * z + pz)
         return found
 
-    def point(self, entity: str) -> np.ndarray:
+    def point(self, entity: str) -> tuple[float, float, float]:
         frame = self.layout.reference_frames.get(entity)
         if frame is not None:
-            return self.pose(frame)[:3, 3]
+            return tuple(self.pose(frame)[:3, 3].tolist())
         if entity in self.layout.bodies:
             return self.centre(entity)
         bounds = self.geo.bounds(self.frames(entity))
-        return np.zeros(3) if bounds is None else (bounds[0] + bounds[1]) / 2.0
+        return (0.0, 0.0, 0.0) if bounds is None else tuple(((bounds[0] + bounds[1]) / 2.0).tolist())
 
     def lowest(self, body: str) -> float:
-        bounds = self.geo.bounds(self.frames(body))
-        return float(bounds[0][2]) if bounds is not None else float(self.root_pose(body)[2, 3])
+        found = self._lowest.get(body)
+        if found is None:
+            bounds = self.geo.bounds(self.frames(body))
+            found = self._lowest[body] = (float(bounds[0][2]) if bounds is not None
+                                          else float(self.root_pose(body)[2, 3]))
+        return found
 
 
 def _point_in_shape(point: np.ndarray, shape: Shape) -> bool:
@@ -111,9 +125,10 @@ def _point_in_shape(point: np.ndarray, shape: Shape) -> bool:
     return bool(np.all(p >= v.min(axis=0)) and np.all(p <= v.max(axis=0)))
 
 
-def _in_box(point: np.ndarray, pose: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
-    local = ((point - pose[:3, 3]) @ pose[:3, :3]).tolist()
-    return all(a <= x <= b for a, x, b in zip(lo.tolist(), local, hi.tolist()))
+def _in_box(point: tuple[float, float, float], pose: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
+    (x0, y0, z0), (x1, y1, z1) = lo.tolist(), hi.tolist()
+    x, y, z = _to_local(point, pose)
+    return x0 <= x <= x1 and y0 <= y <= y1 and z0 <= z <= z1
 
 
 def _param(p: Predicate, name: str) -> float:
@@ -142,8 +157,8 @@ def _released(p: Predicate, s: Scope) -> bool:
 
 def _lifted(p: Predicate, s: Scope) -> bool:
     obj = p.args[0]
-    start = s.layout.initial_low.get(obj, s.lowest(obj))
-    return s.lowest(obj) >= start + _param(p, "by")
+    now = s.lowest(obj)
+    return now >= s.layout.initial_low.get(obj, now) + _param(p, "by")
 
 
 def _open_fraction(p: Predicate, s: Scope) -> float:
@@ -162,7 +177,7 @@ def _inside(p: Predicate, s: Scope) -> bool:
     point = s.centre(p.args[0])
     outer = s.layout.bodies[p.args[1]]
     if outer.cavity is not None:
-        return _point_in_shape(_to_local(point, s.root_pose(outer.name)), outer.cavity)
+        return _point_in_shape(np.array(_to_local(point, s.root_pose(outer.name))), outer.cavity)
     for part in outer.parts:
         if part.link_frame in outer.link_bounds:
             lo, hi = outer.link_bounds[part.link_frame]
@@ -171,23 +186,22 @@ def _inside(p: Predicate, s: Scope) -> bool:
     return _in_box(point, s.root_pose(outer.name), *outer.bounds)
 
 
-def _to_local(point: np.ndarray, pose: np.ndarray) -> np.ndarray:
-    return (point - pose[:3, 3]) @ pose[:3, :3]
+def _to_local(point: tuple[float, float, float], pose: np.ndarray) -> tuple[float, float, float]:
+    """A world point in the frame of ``pose`` (R^T (p - t), in plain floats)."""
+    (r0, r1, r2, px), (r3, r4, r5, py), (r6, r7, r8, pz) = pose[:3].tolist()
+    dx, dy, dz = point[0] - px, point[1] - py, point[2] - pz
+    return dx * r0 + dy * r3 + dz * r6, dx * r1 + dy * r4 + dz * r7, dx * r2 + dy * r5 + dz * r8
 
 
 def _on(p: Predicate, s: Scope) -> bool:
     top, base = p.args
     info = s.layout.bodies[base]
     pose = s.root_pose(base)
-    # the top's centre in the base's frame, in plain floats (numpy's per-call cost
-    # dominates three-vectors; this runs every step for most success conditions)
-    (r0, r1, _, px), (r3, r4, _, py), (r6, r7, r8, pz) = pose[:3].tolist()
-    cx, cy, cz = s.centre(top).tolist()
-    dx, dy, dz = cx - px, cy - py, cz - pz
-    lx, ly = dx * r0 + dy * r3 + dz * r6, dx * r1 + dy * r4 + dz * r7
+    lx, ly, _ = _to_local(s.centre(top), pose)  # the top's centre in the base's frame
     (x0, y0), (x1, y1) = info.footprint
     if not (x0 <= lx <= x1 and y0 <= ly <= y1):
         return False
+    r6, r7, r8, pz = pose[2].tolist()
     surface = r6 * lx + r7 * ly + r8 * info.top + pz
     if abs(s.lowest(top) - surface) > ON_TOLERANCE:
         return False
@@ -218,7 +232,7 @@ EVALUATORS: dict[str, Evaluate] = {
     "on": _on,
     "upright": lambda p, s: tilt_of(s.root_pose(p.args[0])) <= _param(p, "within"),
     "tilted": lambda p, s: tilt_of(s.root_pose(p.args[0])) >= _param(p, "by"),
-    "aligned": lambda p, s: float(np.linalg.norm(s.point(p.args[0]) - s.point(p.args[1]))) <= _param(p, "within"),
+    "aligned": lambda p, s: math.dist(s.point(p.args[0]), s.point(p.args[1])) <= _param(p, "within"),
     "touching": _touching,
     "near": lambda p, s: s.geo.distance(s.frames(p.args[0]), s.frames(p.args[1])) <= _param(p, "within"),
     "pressed": _pressed,
@@ -229,12 +243,11 @@ assert set(EVALUATORS) == set(PREDICATES), "every catalog predicate needs an eva
 def holds(condition: Condition, scope: Scope) -> bool:
     """Whether a condition tree holds in the scope's state."""
     if isinstance(condition, Predicate):
-        known = scope.held.get(id(condition))
-        if known is not None and known[0] is condition:
-            return known[1]
-        value = EVALUATORS[condition.name](condition, scope)
-        scope.held[id(condition)] = (condition, value)
-        return value
+        slot = scope.slots.get(id(condition), id(condition))
+        known = scope.held.get(slot)
+        if known is None:
+            known = scope.held[slot] = EVALUATORS[condition.name](condition, scope)
+        return known
     if isinstance(condition, AllOf):
         return all(holds(item, scope) for item in condition.items)
     if isinstance(condition, AnyOf):
@@ -242,6 +255,26 @@ def holds(condition: Condition, scope: Scope) -> bool:
     if isinstance(condition, Not):
         return not holds(condition.item, scope)
     raise TypeError(f"not a condition: {condition!r}")
+
+
+def predicate_slots(*conditions: Condition) -> dict[int, Hashable]:
+    """id of every predicate in the condition trees -> a key that predicates saying the same
+    thing share (``inside(block, box)`` in a requirement and in the success condition):
+    evaluated once a step. The trees must outlive the slots (they hold the ids)."""
+    slots: dict[int, Hashable] = {}
+
+    def walk(c: Condition) -> None:
+        if isinstance(c, Predicate):
+            slots[id(c)] = (c.name, c.args, tuple(sorted(c.params.items())))
+        elif isinstance(c, (AllOf, AnyOf)):
+            for item in c.items:
+                walk(item)
+        elif isinstance(c, Not):
+            walk(c.item)
+
+    for condition in conditions:
+        walk(condition)
+    return slots
 
 
 def uses_contacts(spec: MonitorSpec) -> bool:
@@ -262,4 +295,4 @@ def predicate_names(condition: Condition) -> set[str]:
 
 
 __all__ = ["CONTACT_PREDICATES", "EVALUATORS", "ON_TOLERANCE", "PRESS_FORCE", "Scope", "holds",
-           "predicate_names", "uses_contacts"]
+           "predicate_names", "predicate_slots", "uses_contacts"]

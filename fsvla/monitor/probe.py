@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -182,6 +182,7 @@ class Probe:
         self._frame_of = {id(c): f for f, c in self.components.items()}
         self._pose_frames = [(f, self.components[f]) for f in pose_frames if f in self.components]
         self._pose_names = tuple(f for f, _ in self._pose_frames)
+        self._pose_index = {f: i for i, f in enumerate(self._pose_names)}
         self._pose_components = [c for _, c in self._pose_frames]
         self._torque = frozenset(torque_frames)
         g = (float(gravity[0]), float(gravity[1]), float(gravity[2]))
@@ -204,11 +205,30 @@ class Probe:
         self._scan_memo_counted = False  # its records are in this control step's maxima
         self._last_memo: dict[tuple[str, str], np.ndarray] | None = None
         self._scan_slept = self._last_slept = False  # guards asleep after the previous substep
-        self.scan = True  # the per-substep pair scan runs
+        self._scan_on = True
         self.read_last = True  # snapshot(contacts=True) reads the last substep's contacts
         self.guards = True  # sleeping guard bodies spare the scans (off: every reading is taken)
         self._native_scan, self._native_last, self._native_poses = (
             self._native_parts(g) if native else (None, None, None))
+        self._fold_native = self._native_fold()
+
+    @property
+    def scan(self) -> bool:
+        """Whether the per-substep pair scan runs."""
+        return self._scan_on
+
+    @scan.setter
+    def scan(self, on: bool) -> None:
+        if on != self._scan_on:
+            self._scan_on = on
+            self._fold_native = self._native_fold()
+
+    def _native_fold(self) -> Callable[[], None] | None:
+        """The native reader's fold of one substep with this probe's arguments bound (it runs
+        25 times a control step: no Python between the call and the reader)."""
+        if self._native_scan is None:
+            return None
+        return self._native_scan.folder(1.0 / self._dt, self._scan_on and bool(self._filter))
 
     def _native_parts(self, gravity: tuple[float, float, float]) -> tuple[
             NativeReader | None, NativeReader | None, NativePoses | None]:
@@ -262,10 +282,10 @@ class Probe:
 
     def record_substep(self) -> None:
         """Fold the physics step just taken into the control step's maxima."""
-        inv_dt = 1.0 / self._dt
-        if self._native_scan is not None:
-            self._native_scan.fold(inv_dt, self.scan and bool(self._filter))
+        if self._fold_native is not None:
+            self._fold_native()
             return
+        inv_dt = 1.0 / self._dt
         for body in self._free:
             body.record(self.maxima, inv_dt)
         if self.scan and self._filter:
@@ -430,9 +450,9 @@ class Probe:
         if not self._pose_frames:
             return PoseMap((), np.zeros((0, 4, 4), dtype=np.float32))
         if self._native_poses is not None:
-            return PoseMap(self._pose_names, self._native_poses.read())
+            return PoseMap(self._pose_names, self._native_poses.read(), self._pose_index)
         return PoseMap(self._pose_names, np.array([c.entity_pose.to_transformation_matrix()
-                                                   for c in self._pose_components]))
+                                                   for c in self._pose_components]), self._pose_index)
 
     def snapshot(self, step: int, time: float, *, contacts: bool = False) -> WorldState:
         """The world now, with the maxima recorded since the last snapshot (which are then
@@ -444,15 +464,14 @@ class Probe:
             if q is None:
                 q = qpos[id(a)] = a.get_qpos()
             joints[k] = float(q[i])
+        maxima, self.maxima = self.maxima, ContactMaxima()  # the state takes this step's maxima
         if self._native_scan is not None:
-            self._native_scan.take(self.maxima)
-        state = WorldState(step=step, time=time, poses=self.poses(), joints=joints,
-                           contact_force=dict(self.maxima.force), contact_torque=dict(self.maxima.torque),
-                           last_contacts=self.last_contacts() if contacts and self.read_last else {},
-                           contacts_read=contacts or self.records_substeps)
-        self.maxima.clear()
+            self._native_scan.take(maxima)
         self._scan_memo_counted = False
-        return state
+        return WorldState(step=step, time=time, poses=self.poses(), joints=joints, contact_force=maxima.force,
+                          contact_torque=maxima.torque,
+                          last_contacts=self.last_contacts() if contacts and self.read_last else {},
+                          contacts_read=contacts or self.records_substeps)
 
 
 def _sleep_flag(component: Any) -> str | None:

@@ -19,7 +19,7 @@ force on the first frame by the second in the step's last substep (both orders p
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,13 +45,33 @@ def pair_key(a: str, b: str) -> Pair:
     return (a, b) if a <= b else (b, a)
 
 
-class PoseMap(dict):
+class PoseMap(Mapping[str, Matrix4]):
     """Frame -> 4x4 pose, read in one pass: ``stack`` holds the matrices in ``names`` order
-    (the values are views of it), so the geometry takes them without re-stacking."""
+    and a pose is a view of it made when asked for (most of a step's poses go to the
+    geometry as the stack, and only a few are read one by one)."""
 
-    def __init__(self, names: tuple[str, ...], stack: NDArray[np.floating]):
-        super().__init__(zip(names, stack))
+    __slots__ = ("_index", "names", "stack")
+
+    def __init__(self, names: tuple[str, ...], stack: NDArray[np.floating],
+                 index: Mapping[str, int] | None = None):
         self.names, self.stack = names, stack
+        self._index = {n: i for i, n in enumerate(names)} if index is None else index
+
+    def __getitem__(self, frame: str) -> Matrix4:
+        return self.stack[self._index[frame]]
+
+    def get(self, frame: str, default: Matrix4 | None = None) -> Matrix4 | None:  # type: ignore[override]
+        i = self._index.get(frame)
+        return default if i is None else self.stack[i]
+
+    def __contains__(self, frame: object) -> bool:
+        return frame in self._index
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.names)
+
+    def __len__(self) -> int:
+        return len(self.names)
 
 
 @dataclass
@@ -93,6 +113,12 @@ class WorldState:
         """Largest substep contact force between a frame of ``a`` and one of ``b``
         (any frame outside ``a`` when ``b`` is None); 0 with no contact."""
         best = 0.0
+        if frames_b is not None and len(frames_a) * len(frames_b) < len(self.contact_force):
+            force = self.contact_force  # fewer frame pairs to look up than contacts to go through
+            for a in frames_a:
+                for b in frames_b:
+                    best = max(best, force.get(pair_key(a, b), 0.0))
+            return best
         for (x, y), value in self.contact_force.items():
             for s, o in ((x, y), (y, x)):
                 if s in frames_a and (o not in frames_a if frames_b is None else o in frames_b):
@@ -108,7 +134,10 @@ class WorldState:
         """Any contact between the groups in the step (any substep, or the last one)."""
         if self.max_force(frames_a, frames_b) > 0.0:
             return True
-        return any(a in frames_a and b in frames_b for a, b in self.last_contacts)
+        last = self.last_contacts
+        if len(frames_a) * len(frames_b) < len(last):
+            return any((a, b) in last for a in frames_a for b in frames_b)
+        return any(a in frames_a and b in frames_b for a, b in last)
 
     def force_on(self, frames: frozenset[str], by: frozenset[str]) -> NDArray[np.float64]:
         """Total force on ``frames`` by ``by`` in the last substep."""

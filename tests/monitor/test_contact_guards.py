@@ -118,3 +118,45 @@ def test_guards_read_what_a_full_scan_reads(name, motion, monkeypatch):
             for key, value in theirs.items():
                 np.testing.assert_array_equal(ours[key], value,
                                            err_msg=f"{name} {motion} step {step} {key}")
+
+
+@pytest.mark.parametrize("motion", ["reach", "sweep"])
+@pytest.mark.parametrize("name", sorted(builtin_scenarios()))
+def test_the_gate_closes_only_on_steps_with_nothing_to_read(name, motion):
+    """The contact gate (``fsvla.monitor.contacts.ContactGate``) turns scans off while no
+    robot link is near a watched body; a monitor without it, reading every substep, must
+    read the same maxima and contacts and give the same margins at every step."""
+    env = fsvla.make(name, monitor=True)
+    actions = _motions()[motion](env, STEPS)
+    env.reset()
+    gated = env.monitor
+    if gated._gate is None:
+        pytest.skip(f"{name} reads no contact pairs")
+    ungated = SafetyMonitor(env.monitor_spec, env.built)
+    ungated._gate = None  # probe.scan and probe.read_last stay on
+    ungated.reset()
+    a, b, closed = [], [], []
+    _record_readings(gated, a)
+    _record_readings(ungated, b)
+    record, end = gated.record_substep, gated.end_step
+    margins = []
+
+    def record_both():
+        record()
+        ungated.record_substep()
+
+    def end_both():
+        closed.append(not (gated.probe.scan and gated.probe.read_last))
+        report = end()
+        margins.append((report.margins, ungated.end_step().margins))
+        return report
+
+    gated.record_substep, gated.end_step = record_both, end_both
+    for action in actions:
+        env.step(action)
+    assert ungated.probe.scan and ungated.probe.read_last
+    for step, (x, y) in enumerate(zip(a, b)):
+        assert x == y, (name, motion, step)
+    for step, (x, y) in enumerate(margins, start=1):
+        np.testing.assert_array_equal(x, y, err_msg=f"{name} {motion} step {step}")
+    assert any(closed), "the gate never closed: the test compared nothing"

@@ -48,3 +48,76 @@ def test_empty_groups_and_moves():
     assert geometry.distance(A, B) == pytest.approx(0.15)
     geometry.set_poses({"b": _at(0.05)})  # overlapping: the penetration depth
     assert geometry.distance(A, B) == pytest.approx(-0.05, abs=1e-3)
+
+
+def _pose(rng: np.random.Generator, centre: np.ndarray, turn: float) -> np.ndarray:
+    """A random rotation of up to ``turn`` rad about a random axis, at ``centre``."""
+    from scipy.spatial.transform import Rotation
+
+    axis = rng.normal(size=3)
+    m = np.eye(4)
+    m[:3, :3] = Rotation.from_rotvec(axis / np.linalg.norm(axis) * rng.uniform(0, turn)).as_matrix()
+    m[:3, 3] = centre
+    return m
+
+
+def test_a_piece_moves_no_farther_than_its_carried_bound():
+    from fsvla.monitor.kernels import _moved
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        then, now = _pose(rng, rng.uniform(-1, 1, 3), np.pi), _pose(rng, rng.uniform(-1, 1, 3), np.pi)
+        centre, radius = rng.uniform(-0.2, 0.2, 3), rng.uniform(0.0, 0.1)
+        offsets = rng.normal(size=(50, 3))
+        offsets *= radius * rng.uniform(0, 1, (50, 1)) / np.linalg.norm(offsets, axis=1, keepdims=True)
+        points = centre + offsets  # within radius of the centre, in the frame
+        moved = np.linalg.norm(points @ now[:3, :3].T + now[:3, 3] - points @ then[:3, :3].T - then[:3, 3], axis=1)
+        assert moved.max() <= _moved.py_func(now, then, centre, radius) + 1e-12
+    assert _moved.py_func(now, now, centre, radius) == 0.0
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_carried_bounds_keep_a_moving_minimum_exact(seed: int, monkeypatch):
+    """Box clouds drift, turn and pass through each other: every step's minimum equals brute
+    force, and the bounds carried from the step before spare most exact queries."""
+    import fsvla.monitor.geometry as module
+
+    calls = []
+    exact = module.signed_distance
+    monkeypatch.setattr(module, "signed_distance", lambda a, b: calls.append(1) or exact(a, b))
+    rng = np.random.default_rng(seed)
+    core = BoxShape(half_size=(0.05, 0.05, 0.05))  # at both origins: the clouds pass through each other
+    sa, sb = [core, *_boxes(rng, 10)], [core, *_boxes(rng, 8)]
+    geometry = SceneGeometry()
+    geometry.add("a", sa)
+    geometry.add("b", sb, _at(0.6))
+    steps, fresh, deepest = 60, 0, MAX_DISTANCE
+    for t in range(steps):
+        pose = _pose(rng, np.array([0.6 - 0.012 * t, 0.0, 0.0]), 0.02)
+        geometry.set_poses({"b": pose})
+        brute = min_distance(pieces_of("a", sa), pieces_of("b", sb, pose))
+        fresh += len(sa) * len(sb)
+        assert geometry.distance(A, B) == pytest.approx(brute, abs=1e-9), t
+        deepest = min(deepest, brute)
+        lower = geometry.distance(A, B, exact_below=brute - 0.05)
+        assert lower >= brute - 0.05
+    assert deepest < 0.0  # they passed through each other
+    assert len(calls) < fresh / 10
+
+
+def test_group_bounds_hold_every_piece_of_every_frame():
+    rng = np.random.default_rng(5)
+    geometry = SceneGeometry()
+    shapes = {f: _boxes(rng, 4) for f in ("a", "b", "c")}
+    for f, s in shapes.items():
+        geometry.add(f, s)
+    poses = {f: _pose(rng, rng.uniform(-1, 1, 3), np.pi) for f in shapes}
+    geometry.set_poses(poses)
+    for group in (frozenset({"a"}), frozenset({"a", "c"}), frozenset({"a", "b", "c", "nothing"})):
+        corners = np.concatenate([
+            (np.array(np.meshgrid(*[(-1, 1)] * 3)).reshape(3, -1).T * box.half_size + box.pose.position)
+            @ poses[f][:3, :3].T + poses[f][:3, 3] for f in group if f in shapes for box in shapes[f]])
+        lo, hi = geometry.bounds(group)
+        np.testing.assert_allclose(lo, corners.min(axis=0), atol=1e-12)
+        np.testing.assert_allclose(hi, corners.max(axis=0), atol=1e-12)
+    assert geometry.bounds(frozenset({"nothing"})) is None

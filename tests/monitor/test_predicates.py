@@ -104,3 +104,26 @@ def test_opened_and_closed_read_the_part_joint():
     assert not holds(P("opened", "cabinet", fraction=0.6), scope(0.5))
     assert holds(P("closed", "cabinet", fraction=0.1), scope(0.05))
     assert not holds(P("closed", "cabinet", fraction=0.1), scope(0.5))
+
+
+def test_predicates_that_say_the_same_thing_are_evaluated_once_a_step(world, monkeypatch):
+    from fsvla.monitor.predicates import predicate_slots
+
+    calls = []
+    lifted = EVALUATORS["lifted"]
+    monkeypatch.setitem(EVALUATORS, "lifted", lambda p, s: calls.append(p) or lifted(p, s))
+    first, again, other = P("lifted", "pot", by=0.03), P("lifted", "pot", by=0.03), P("lifted", "pot", by=0.05)
+    condition = AllOf(items=(first, Not(item=other)))
+    slots = predicate_slots(condition, AnyOf(items=(again,)))
+    assert slots[id(first)] == slots[id(again)] != slots[id(other)]
+    base = world[1]
+    up = dict(base, pot=base["pot"] @ translation(0, 0, 0.04))
+    evaluator, _ = world
+    scope = _scope(world, up)
+    scope = Scope(scope.state, evaluator.layout, evaluator.geometry, slots)
+    calls.clear()  # what the evaluator's reset asked
+    assert holds(condition, scope) and holds(again, scope)
+    assert calls == [first, other]  # `again` took `first`'s answer
+    scope = _scope(world, up)
+    calls.clear()
+    assert holds(condition, scope) and holds(again, scope) and len(calls) == 3  # without slots: each its own
