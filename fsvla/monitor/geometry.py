@@ -43,7 +43,7 @@ from fsvla.compiler.assets.model import (
     Shape,
     SphereShape,
 )
-from fsvla.compiler.collision import CollisionPiece, fcl_transform, pieces_of, signed_distance
+from fsvla.compiler.collision import CollisionPiece, pieces_of, signed_distance
 
 from . import kernels
 from .state import Matrix4
@@ -183,6 +183,8 @@ class SceneGeometry:
         self._pf = np.array(self._piece_frame, dtype=np.int64)
         self._pose_array = np.array(self._poses, dtype=np.float64).reshape(-1, 4, 4)
         self._plo, self._phi = np.zeros_like(self._c), np.zeros_like(self._c)
+        self._locals = np.array([p.local for p in self._pieces], dtype=np.float64).reshape(-1, 4, 4)
+        self._rotations, self._translations = np.zeros((len(self._pieces), 3, 3)), np.zeros((len(self._pieces), 3))
         self._groups.clear()
         self._moves.clear()
         self._group_frames.clear()
@@ -255,11 +257,16 @@ class SceneGeometry:
 
     def _fcl(self, piece: int) -> CollisionPiece:
         frame = self._piece_frame[piece]
+        found = self._pieces[piece]
         if self._placed[piece] != self._stamp[frame]:
-            p = self._pieces[piece]
-            p.obj.setTransform(fcl_transform(self._pose_array[frame] @ p.local))
+            # rows of contiguous buffers: FCL takes them as they are (a Transform built from
+            # slices of the pose costs twice as much, and this runs for every query)
+            rotation, translation = self._rotations[piece], self._translations[piece]
+            kernels.place_piece(self._pose_array, frame, self._locals[piece], rotation, translation)
+            found.obj.setRotation(rotation)
+            found.obj.setTranslation(translation)
             self._placed[piece] = self._stamp[frame]
-        return self._pieces[piece]
+        return found
 
     # --- queries --------------------------------------------------------------------------
 
@@ -365,20 +372,17 @@ class SceneGeometry:
         if not self._frozen:
             self._freeze()
         key = (a, b)
-        ia, ib, frames, _ = self._pair(a, b)
         found = self._prefetched.get(key)
-        if found is not None and self._prefetched_at == self._moves_made:
-            version = found[0]  # nothing moved since the prefetch summed these stamps
-        else:
-            found, version = None, int(self._stamp[frames].sum())
+        fresh = found is not None and self._prefetched_at == self._moves_made  # nothing moved since
+        if fresh and found[1] >= exact_below:  # far at the frame level already
+            return found[1]
+        ia, ib, frames, _ = self._pair(a, b)
+        version = found[0] if fresh else int(self._stamp[frames].sum())  # the prefetch summed these stamps
         cached = self._memo.get(key)
         if cached is not None and cached[2] == version and (cached[0] < cached[1] or cached[1] >= exact_below):
             return cached[0]
         if len(ia) == 0 or len(ib) == 0:
             return MAX_DISTANCE
-        if found is not None and found[1] >= exact_below:
-            self._memo[key] = (found[1], exact_below, version)  # far at the frame level already
-            return found[1]
         lower, known, order, n, beyond = self._carry(key, ia, ib, exact_below)
         if n == 0:  # every pair is far: the bounds answer
             beyond = min(beyond, MAX_DISTANCE)

@@ -82,6 +82,22 @@ def move_frames(stack: NDArray, frames: NDArray[np.int64], poses: NDArray[np.flo
     return moved
 
 
+@njit(cache=True, nogil=True)
+def place_piece(poses: NDArray[np.float64], frame: int, local: NDArray[np.float64],
+                rotation: NDArray[np.float64], translation: NDArray[np.float64]) -> None:
+    """A piece's world transform ``poses[frame] @ local`` (summed in matmul's order), as
+    the contiguous rotation and translation FCL takes without copying."""
+    for i in range(3):
+        for j in range(4):
+            total = 0.0
+            for k in range(4):
+                total += poses[frame, i, k] * local[k, j]
+            if j < 3:
+                rotation[i, j] = total
+            else:
+                translation[i] = total
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _distance(lo: NDArray[np.float64], hi: NDArray[np.float64], a: int, b: int) -> float:
     total = 0.0
@@ -280,7 +296,8 @@ def warm_up() -> None:
     contact_gate(boxes, boxes, boxes, boxes, rows, rows, rows, flags, flags, rows, rows, rows, rows, flags, flags,
                  True, True, 0.1)
     inside_margin(boxes, poses[0], poses[1], 0.0, 0.0, 1.0, 1.0)
+    place_piece(poses, 0, poses[1], np.zeros((3, 3)), np.zeros(3))
 
 
-__all__ = ["any_within", "apply_poses", "carry_bounds", "contact_gate", "inside_margin", "move_frames", "nearest_per_query",
+__all__ = ["any_within", "apply_poses", "carry_bounds", "contact_gate", "inside_margin", "move_frames", "nearest_per_query", "place_piece",
            "update_bounds", "warm_up"]

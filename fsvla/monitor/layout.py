@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -70,8 +71,9 @@ class Layout:
     initial: dict[str, Matrix4] = field(default_factory=dict)  # body -> root pose at reset
     initial_low: dict[str, float] = field(default_factory=dict)  # body -> lowest z at reset
 
-    @property
+    @cached_property
     def grippers(self) -> frozenset[str]:
+        """Every arm's gripper frames (one set, made once: predicates ask every step)."""
         return frozenset().union(*(a.gripper for a in self.arms.values()))
 
     def frames(self, entity: str) -> frozenset[str]:

@@ -76,6 +76,19 @@ def test_a_piece_moves_no_farther_than_its_carried_bound():
     assert _moved.py_func(now, now, centre, radius) == 0.0
 
 
+def test_a_piece_is_placed_where_its_frame_puts_it():
+    from fsvla.monitor.kernels import place_piece
+
+    rng = np.random.default_rng(4)
+    poses = np.stack([_pose(rng, rng.uniform(-1, 1, 3), np.pi) for _ in range(3)])
+    local = _pose(rng, rng.uniform(-0.1, 0.1, 3), np.pi)
+    rotation, translation = np.zeros((3, 3)), np.zeros(3)
+    place_piece(poses, 2, local, rotation, translation)
+    world = poses[2] @ local
+    np.testing.assert_allclose(rotation, world[:3, :3], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(translation, world[:3, 3], rtol=0, atol=1e-15)
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_carried_bounds_keep_a_moving_minimum_exact(seed: int, monkeypatch):
     """Box clouds drift, turn and pass through each other: every step's minimum equals brute
