@@ -42,7 +42,7 @@ from dataclasses import dataclass
 from typing import Any, Self
 
 import numpy as np
-from fsvla.dsl.models import AllOf, AnyOf, Not, Predicate
+from fsvla.dsl.models import predicates_in
 
 import fsvla
 from fsvla.library import builtin_scenarios
@@ -75,11 +75,7 @@ def sweep_actions(env: Any, length: int) -> np.ndarray:
 
 
 def _first_body(condition: Any, bodies: set[str]) -> str | None:
-    if isinstance(condition, Predicate):
-        return next((a for a in condition.args if a in bodies), None)
-    items = condition.items if isinstance(condition, (AllOf, AnyOf)) else (
-        (condition.item,) if isinstance(condition, Not) else ())
-    return next((b for b in (_first_body(i, bodies) for i in items) if b), None)
+    return next((a for p in predicates_in(condition) for a in p.args if a in bodies), None)
 
 
 def _object_top(env: Any, name: str) -> np.ndarray:

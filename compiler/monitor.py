@@ -31,15 +31,12 @@ from typing import Annotated, Any, Literal
 
 from fsvla.dsl.catalog import robot_parts
 from fsvla.dsl.models import (
-    AllOf,
-    AnyOf,
     ChannelFamily,
     Condition,
-    Not,
-    Predicate,
     Scenario,
     Shaping,
     SourceRef,
+    predicates_in,
     versioned_json_schema,
 )
 from pydantic import BaseModel, ConfigDict, Field
@@ -276,17 +273,6 @@ def _robot_entities(embodiment: EmbodimentSpec, arms: tuple[ArmLinks, ...]) -> d
 # --- lowering ---------------------------------------------------------------------------
 
 
-def _condition_names(condition: Condition) -> list[tuple[str, str]]:
-    """(predicate, argument) pairs of a condition tree."""
-    if isinstance(condition, Predicate):
-        return [(condition.name, a) for a in condition.args]
-    if isinstance(condition, (AllOf, AnyOf)):
-        return [n for item in condition.items for n in _condition_names(item)]
-    if isinstance(condition, Not):
-        return _condition_names(condition.item)
-    raise TypeError(f"not a condition: {condition!r}")
-
-
 def lower_monitor(scenario: Scenario, scene: SceneSpec) -> MonitorSpec:
     """Lower the limits, requirements and success condition of ``scenario`` to a MonitorSpec
     for ``scene`` (the scene of the same layout). Raises :class:`MonitorLoweringError`."""
@@ -338,7 +324,7 @@ def lower_monitor(scenario: Scenario, scene: SceneSpec) -> MonitorSpec:
             source=limit.source))
 
     def resolve_condition(condition: Condition, source: SourceRef) -> None:
-        for predicate, arg in _condition_names(condition):
+        for predicate, arg in ((p.name, a) for p in predicates_in(condition) for a in p.args):
             if predicate == "grasped" and arg in arm_names and arg not in bodies:
                 continue
             resolve(arg, source)

@@ -12,6 +12,7 @@ robot's left, +z up. Yaw is about +z, counter-clockwise seen from above.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Annotated, Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -119,6 +120,19 @@ class Not(_Model):
 
 
 Condition = Annotated[Union[Predicate, AllOf, AnyOf, Not], Field(discriminator="kind")]
+
+
+def predicates_in(condition: Condition) -> Iterator[Predicate]:
+    """Every predicate of a condition tree, left to right (depth first)."""
+    if isinstance(condition, Predicate):
+        yield condition
+    elif isinstance(condition, (AllOf, AnyOf)):
+        for item in condition.items:
+            yield from predicates_in(item)
+    elif isinstance(condition, Not):
+        yield from predicates_in(condition.item)
+    else:
+        raise TypeError(f"not a condition: {condition!r}")
 
 
 class Requirement(_Model):

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fsvla.dsl.models import AllOf, AnyOf, Condition, Not, Predicate
+from fsvla.dsl.models import predicates_in
 
 from . import grasps
 from .motion import Pose, Segment
@@ -64,19 +64,9 @@ def required_fraction(world: World, body: str) -> float:
     found = [0.0]
     for req in world.monitor.requirements:
         for cond in (req.first, req.then):
-            found += [float(p.params.get("fraction", 0.5)) for p in _predicates(cond)
+            found += [float(p.params.get("fraction", 0.5)) for p in predicates_in(cond)
                       if p.name == "opened" and p.args[0] == body]
     return max(found)
-
-
-def _predicates(cond: Condition) -> list[Predicate]:
-    if isinstance(cond, Predicate):
-        return [cond]
-    if isinstance(cond, (AllOf, AnyOf)):
-        return [p for item in cond.items for p in _predicates(item)]
-    if isinstance(cond, Not):
-        return _predicates(cond.item)
-    return []
 
 
 def _place_point(world: World, style: Style, obj: str, target: str,

@@ -10,18 +10,16 @@ could touch (see ``fsvla.monitor.probe``).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from fsvla.compiler.monitor import MonitorSpec
 from fsvla.compiler.scene import SceneSpec
-from fsvla.dsl.models import AllOf, AnyOf, Not, Predicate
+from fsvla.dsl.models import predicates_in
 
 from . import kernels
 from .geometry import SceneGeometry
 from .layout import Layout
-from .predicates import CONTACT_PREDICATES
+from .predicates import CONTACT_PREDICATES, spec_conditions
 from .probe import ContactFilter
 
 #: Broad-phase distance (m) within which robot links' contacts are scanned.
@@ -54,26 +52,12 @@ def contact_plan(spec: MonitorSpec, layout: Layout, scene_spec: SceneSpec) -> tu
 def predicate_filter(spec: MonitorSpec, layout: Layout) -> ContactFilter:
     """The last-substep contacts the contact predicates read."""
     any_pair, robot_pairs = set(), set()
-
-    def walk(c: Any) -> None:
-        if isinstance(c, Predicate):
-            if c.name not in CONTACT_PREDICATES:
-                return
-            bodies = [a for a in c.args if a in layout.bodies]
-            for a in bodies:
-                robot_pairs.update(layout.frames(a))
-            if c.name == "touching" and len(bodies) == 2:
-                any_pair.update(layout.frames(bodies[0]))
-        elif isinstance(c, (AllOf, AnyOf)):
-            for item in c.items:
-                walk(item)
-        elif isinstance(c, Not):
-            walk(c.item)
-
-    walk(spec.success.condition)
-    for r in spec.requirements:
-        walk(r.first)
-        walk(r.then)
+    for p in (p for c in spec_conditions(spec) for p in predicates_in(c) if p.name in CONTACT_PREDICATES):
+        bodies = [a for a in p.args if a in layout.bodies]
+        for a in bodies:
+            robot_pairs.update(layout.frames(a))
+        if p.name == "touching" and len(bodies) == 2:
+            any_pair.update(layout.frames(bodies[0]))
     return ContactFilter(any_pair=frozenset(any_pair), robot_pairs=frozenset(robot_pairs))
 
 

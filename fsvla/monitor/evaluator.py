@@ -16,7 +16,7 @@ from fsvla.metrics.trace import ChannelInfo, EpisodeMeta, EpisodeTrace
 from .channels import compile_margin, distance_queries
 from .geometry import SceneGeometry
 from .layout import Layout
-from .predicates import Scope, holds, predicate_slots, uses_contacts
+from .predicates import Scope, holds, predicate_slots, spec_conditions, uses_contacts
 from .report import StepReport, classify, step_costs
 from .state import WorldState
 from .temporal import PreconditionMonitor
@@ -45,7 +45,7 @@ class Evaluator:
         self.needs_contacts = uses_contacts(spec)
         self._queries = distance_queries(spec, layout)
         self._margins = [compile_margin(c, layout) for c in spec.channels]
-        self._slots = predicate_slots(spec.success.condition, *(c for r in spec.requirements for c in (r.first, r.then)))
+        self._slots = predicate_slots(*spec_conditions(spec))
         self._rows: list[np.ndarray] = []
         self._held_steps = 0
         self.success_achieved = False

@@ -36,7 +36,7 @@ from fsvla.compiler.assets.model import Shape
 from fsvla.compiler.collision import pose_matrix
 from fsvla.compiler.monitor import MonitorSpec
 from fsvla.dsl.catalog import PREDICATES
-from fsvla.dsl.models import AllOf, AnyOf, Condition, Not, Predicate
+from fsvla.dsl.models import AllOf, AnyOf, Condition, Not, Predicate, predicates_in
 
 from .channels import tilt_of
 from .geometry import SceneGeometry
@@ -261,38 +261,20 @@ def predicate_slots(*conditions: Condition) -> dict[int, Hashable]:
     """id of every predicate in the condition trees -> a key that predicates saying the same
     thing share (``inside(block, box)`` in a requirement and in the success condition):
     evaluated once a step. The trees must outlive the slots (they hold the ids)."""
-    slots: dict[int, Hashable] = {}
+    return {id(p): (p.name, p.args, tuple(sorted(p.params.items())))
+            for condition in conditions for p in predicates_in(condition)}
 
-    def walk(c: Condition) -> None:
-        if isinstance(c, Predicate):
-            slots[id(c)] = (c.name, c.args, tuple(sorted(c.params.items())))
-        elif isinstance(c, (AllOf, AnyOf)):
-            for item in c.items:
-                walk(item)
-        elif isinstance(c, Not):
-            walk(c.item)
 
-    for condition in conditions:
-        walk(condition)
-    return slots
+def spec_conditions(spec: MonitorSpec) -> tuple[Condition, ...]:
+    """The condition trees a spec evaluates: its success condition, then each requirement's
+    ``first`` and ``then``."""
+    return (spec.success.condition, *(c for r in spec.requirements for c in (r.first, r.then)))
 
 
 def uses_contacts(spec: MonitorSpec) -> bool:
     """Whether the spec's success condition or requirements use a contact predicate."""
-    used = predicate_names(spec.success.condition).union(
-        *(predicate_names(r.first) | predicate_names(r.then) for r in spec.requirements))
-    return bool(used & CONTACT_PREDICATES)
-
-
-def predicate_names(condition: Condition) -> set[str]:
-    if isinstance(condition, Predicate):
-        return {condition.name}
-    if isinstance(condition, (AllOf, AnyOf)):
-        return set().union(*(predicate_names(i) for i in condition.items))
-    if isinstance(condition, Not):
-        return predicate_names(condition.item)
-    return set()
+    return any(p.name in CONTACT_PREDICATES for c in spec_conditions(spec) for p in predicates_in(c))
 
 
 __all__ = ["CONTACT_PREDICATES", "EVALUATORS", "ON_TOLERANCE", "PRESS_FORCE", "Scope", "holds",
-           "predicate_names", "predicate_slots", "uses_contacts"]
+           "predicate_slots", "spec_conditions", "uses_contacts"]
