@@ -129,8 +129,10 @@ class SceneGeometry:
         self._groups: dict[frozenset[str], NDArray[np.int64]] = {}
         self._memo: dict[tuple[frozenset[str], frozenset[str]], tuple[float, float, int]] = {}
         self._pairs: dict[tuple[frozenset[str], frozenset[str]], tuple] = {}
-        # per query: lower bounds of its piece pairs' distances, which are exact, the poses they hold at
-        self._carried: dict[tuple[frozenset[str], frozenset[str]], tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]] = {}
+        # per query: lower bounds of its piece pairs' distances, which are exact, the poses they
+        # hold at, and the buffer their order is sorted into (kernels.carry_bounds)
+        self._carried: dict[tuple[frozenset[str], frozenset[str]],
+                            tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64], NDArray[np.int64]]] = {}
         self._batches: dict[tuple, tuple] = {}
         self._bound_rows: dict[frozenset[str], NDArray[np.int64]] = {}  # frame-bound rows of a group
         self._prefetched: dict[tuple[frozenset[str], frozenset[str]], tuple[int, float]] = {}
@@ -445,5 +447,6 @@ class SceneGeometry:
         if len(rows) == 0:
             return None
         return self._flo[rows].min(axis=0), self._fhi[rows].max(axis=0)
+
 
 __all__ = ["MAX_DISTANCE", "POSE_TOLERANCE", "SceneGeometry", "shapes_of_sapien"]
