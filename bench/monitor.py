@@ -24,7 +24,7 @@ the monitor off and on, the median of the paired differences and its ratio to th
 step, the *mean* ratio (the time the monitor added over all timed steps / their time
 with it off: what it adds to a whole episode; contact scans make the cost heavy-tailed,
 so this is the figure the target applies to: at most 15 %), and the monitor's own time
-per control step (its 25 ``record_substep`` calls and ``end_step``, timed in every other
+per control step (its 25 substep recordings and ``end_step``, timed in every other
 pair, which is then left out of the env-step figures).
 
     python bench/monitor.py [--steps 300] [--rounds 3] [--motions sweep,reach,expert] [--only NAME]
@@ -167,18 +167,26 @@ class Runner:
 
 
 class MonitorProbe:
-    """Times the env's monitor's record_substep and end_step by shadowing them on the
-    instance (the env builds a new monitor with every scene, so it is looked up anew)."""
+    """Times the env's monitor's substep recording and end_step by shadowing its
+    ``substep_recorder`` and ``end_step`` on the instance (the env builds a new monitor
+    with every scene, so it is looked up anew)."""
 
     def __init__(self, env: Any):
         self.env = env
         self.substep_acc = 0.0
         self.substep: list[float] = []
         self.end: list[float] = []
+        self._record: Callable[[], None] | None = None
+
+    def _timed_recorder(self) -> Callable[[], None] | None:
+        start = time.perf_counter()
+        self._record = self.substep_recorder()
+        self.substep_acc += time.perf_counter() - start
+        return None if self._record is None else self._timed_substep
 
     def _timed_substep(self) -> None:
         start = time.perf_counter()
-        self.record_substep()
+        self._record()  # type: ignore[misc]
         self.substep_acc += time.perf_counter() - start
 
     def _timed_end(self) -> Any:
@@ -191,12 +199,12 @@ class MonitorProbe:
 
     def __enter__(self) -> Self:
         self.monitor = self.env.monitor
-        self.record_substep, self.end_step = self.monitor.record_substep, self.monitor.end_step
-        self.monitor.record_substep, self.monitor.end_step = self._timed_substep, self._timed_end
+        self.substep_recorder, self.end_step = self.monitor.substep_recorder, self.monitor.end_step
+        self.monitor.substep_recorder, self.monitor.end_step = self._timed_recorder, self._timed_end
         return self
 
     def __exit__(self, *exc: object) -> None:
-        del self.monitor.record_substep, self.monitor.end_step  # back to the class's methods
+        del self.monitor.substep_recorder, self.monitor.end_step  # back to the class's methods
         self.substep_acc = 0.0
 
 
@@ -313,7 +321,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print()
     print(f"per control step (ms), medians over {args.rounds} round(s) of {args.steps}+ steps each: env step with")
     print("the monitor off / on, the difference; its ratio to the off step as medians and as means (added")
-    print("time / off time over all timed steps); the monitor's own time = its 25 record_substep calls")
+    print("time / off time over all timed steps); the monitor's own time = its 25 substep recordings")
     print("+ end_step; the worst round's mean ratio")
     print(table(summary, worst_round))
     worst = max(summary, key=lambda r: r.mean_ratio)

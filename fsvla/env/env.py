@@ -153,10 +153,11 @@ class FsvlaEnv(gymnasium.Env):
         commands = self.codec.decode(action)
         self._stepped = True
         ik_errors = self._apply(commands)
+        record = self.monitor.substep_recorder() if self.monitor is not None else None
         for _ in range(self.substeps):
             self.built.step(1)
-            if self.monitor is not None:
-                self.monitor.record_substep()
+            if record is not None:
+                record()
         self._t += 1
         info: dict[str, Any] = {"step": self._t}
         success = violation = False

@@ -5,8 +5,10 @@ An env drives it in this order (dm_control's hooks: episode init, after substep,
     monitor = SafetyMonitor(monitor_spec, built)     # once per built scene
     built.reset(); monitor.reset()                   # t = 0
     for each control step:
+        record = monitor.substep_recorder()          # None: nothing to record this step
         for each of monitor.substeps physics steps:
-            built.step(1); monitor.record_substep()  # force maxima, every substep
+            built.step(1); record and record()       # force maxima, every substep
+                                                     # (monitor.record_substep() does the same)
         report = monitor.end_step()                  # margins, states, costs, success
     trace = monitor.trace(meta)                      # an fsvla.metrics EpisodeTrace
 
@@ -23,7 +25,7 @@ control step, and PhysX makes no contact beyond its contact offset (4 mm).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from fsvla.compiler.monitor import MonitorSpec, RobotEntity
@@ -110,6 +112,12 @@ class SafetyMonitor:
     def record_substep(self) -> None:
         """Call after every physics substep: folds its contacts into the step's maxima."""
         self.probe.record_substep()
+
+    def substep_recorder(self) -> Callable[[], None] | None:
+        """The call to make after each physics substep of the coming control step (the same
+        as :meth:`record_substep`, with less in between), or None when there is nothing to
+        record in it. Ask again every control step: the contact gate changes it."""
+        return self.probe.substep_recorder()
 
     def end_step(self) -> StepReport:
         """Call after the control step's last substep: the step's report."""

@@ -22,11 +22,15 @@ from __future__ import annotations
 import ctypes
 import functools
 import hashlib
+import importlib.machinery
+import importlib.util
 import logging
 import os
 import re
 import shutil
 import subprocess
+import sys
+import sysconfig
 import tempfile
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -40,6 +44,7 @@ from .state import NET, ContactMaxima
 log = logging.getLogger(__name__)
 
 SOURCE = Path(__file__).with_name("native") / "contacts.cpp"
+BOUND_SOURCE = SOURCE.with_name("bound.cpp")
 SWITCH = "FSVLA_NATIVE_CONTACTS"
 _ROWS = 64  # initial capacity of the row buffers; they grow when a reading needs more
 
@@ -86,25 +91,22 @@ def _compiler() -> str:
     return compiler
 
 
-def build(target_dir: Path | None = None) -> Path:
-    """The shared library, compiled now unless the cache holds this source's build for this
-    SAPIEN. Raises :class:`NativeUnavailable` with the reason when it cannot be built."""
-    import sapien
-
-    include, eigen, compiler = _sapien_include(), _eigen_include(), _compiler()
+def _compile(source: Path, stem: str, key: Sequence[bytes], flags: Sequence[str], target_dir: Path | None) -> Path:
+    """``source`` compiled into a shared library in the cache (``stem-<digest>.so``), unless
+    the cache holds the build for this source, ``key`` and compiler."""
+    compiler = _compiler()
     digest = hashlib.sha256()
-    for part in (SOURCE.read_bytes(), sapien.__version__.encode(), str(include).encode(), compiler.encode()):
+    for part in (source.read_bytes(), *key, compiler.encode()):
         digest.update(part)
     folder = target_dir or cache_dir() / "native"
-    target = folder / f"contacts-{digest.hexdigest()[:16]}.so"
+    target = folder / f"{stem}-{digest.hexdigest()[:16]}.so"
     if target.is_file():
         return target
     folder.mkdir(parents=True, exist_ok=True)
     # a private name, then an atomic rename: processes building at once never see a part
-    fd, partial = tempfile.mkstemp(dir=folder, prefix=".contacts-", suffix=".so")
+    fd, partial = tempfile.mkstemp(dir=folder, prefix=f".{stem}-", suffix=".so")
     os.close(fd)
-    command = [compiler, "-O2", "-std=c++20", "-shared", "-fPIC", "-Wl,-z,defs", "-w",
-               f"-I{include}", f"-I{include / 'physx' / 'include'}", f"-I{eigen}", str(SOURCE), "-o", partial]
+    command = [compiler, "-O2", "-std=c++20", "-shared", "-fPIC", "-w", *flags, str(source), "-o", partial]
     try:
         try:
             done = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
@@ -112,12 +114,59 @@ def build(target_dir: Path | None = None) -> Path:
             raise NativeUnavailable(f"could not run the C++ compiler {compiler!r}: {error}") from error
         if done.returncode != 0:
             tail = " ".join(done.stderr.strip().splitlines()[-3:])
-            raise NativeUnavailable(f"compiling {SOURCE.name} failed: {tail}")
+            raise NativeUnavailable(f"compiling {source.name} failed: {tail}")
         os.replace(partial, target)
     finally:
         if os.path.exists(partial):
             os.unlink(partial)
     return target
+
+
+def build(target_dir: Path | None = None) -> Path:
+    """The contact reader's shared library, compiled now unless the cache holds this
+    source's build for this SAPIEN. Raises :class:`NativeUnavailable` with the reason when
+    it cannot be built."""
+    import sapien
+
+    include, eigen = _sapien_include(), _eigen_include()
+    # -z defs: a symbol SAPIEN's headers declare but nothing defines fails here, not at load
+    flags = ["-Wl,-z,defs", f"-I{include}", f"-I{include / 'physx' / 'include'}", f"-I{eigen}"]
+    return _compile(SOURCE, "contacts", (sapien.__version__.encode(), str(include).encode()), flags, target_dir)
+
+
+def _python_include() -> Path:
+    include = Path(sysconfig.get_paths()["include"])
+    if not (include / "Python.h").is_file():
+        raise NativeUnavailable(f"this Python's C headers are not installed ({include}; install python3-dev)")
+    return include
+
+
+def build_bound(target_dir: Path | None = None) -> Path:
+    """The bound-call extension module (``native/bound.cpp``) for this interpreter."""
+    include = _python_include()
+    key = (sys.version.encode(), str(sysconfig.get_config_var("EXT_SUFFIX")).encode(), str(include).encode())
+    # Python's own symbols resolve against the interpreter that loads it, as any extension's
+    return _compile(BOUND_SOURCE, "bound", key, [f"-I{include}"], target_dir)
+
+
+@functools.cache
+def bound_calls() -> Any | None:
+    """The bound-call module (``bind``), or None where it cannot be built (the reason is
+    logged once): callers then keep their ctypes calls, which cost more a call."""
+    if os.environ.get(SWITCH, "1").strip().lower() in {"0", "false", "no", "off"}:
+        return None
+    try:
+        path = build_bound()
+        loader = importlib.machinery.ExtensionFileLoader("_fsvla_bound", str(path))
+        spec = importlib.util.spec_from_file_location("_fsvla_bound", path, loader=loader)
+        if spec is None:
+            raise NativeUnavailable(f"cannot load {path}")
+        module = importlib.util.module_from_spec(spec)
+        loader.exec_module(module)
+        return module
+    except (NativeUnavailable, ImportError, OSError, subprocess.SubprocessError) as error:
+        log.warning("bound native calls unavailable, calling the contact reader through ctypes: %s", error)
+        return None
 
 
 class NativeLibrary:
@@ -301,7 +350,12 @@ class NativeReader:
 
     def folder(self, inv_dt: float, scan: bool) -> Callable[[], None]:
         """A callable that folds the substep just taken: free bodies, and the kept pairs if
-        ``scan`` (the reader's call with its arguments bound: it runs every substep)."""
+        ``scan`` (the reader's call with its arguments bound: it runs every substep, so
+        through :func:`bound_calls` where it can be built, else ctypes)."""
+        bound = bound_calls()
+        if bound is not None:
+            address = ctypes.cast(self._lib.fsvla_reader_fold, ctypes.c_void_p).value
+            return bound.bind(address, self._handle, inv_dt, int(scan), self)
         return functools.partial(self._lib.fsvla_reader_fold, self._handle, inv_dt, scan)
 
     def take(self, maxima: ContactMaxima, clear: bool = True) -> None:
@@ -350,4 +404,5 @@ class NativeReader:
         return n
 
 
-__all__ = ["FreeBodySpec", "NativeLibrary", "NativePoses", "NativeReader", "NativeUnavailable", "build", "native_library"]
+__all__ = ["FreeBodySpec", "NativeLibrary", "NativePoses", "NativeReader", "NativeUnavailable", "bound_calls", "build",
+           "build_bound", "native_library"]

@@ -280,6 +280,16 @@ class Probe:
             for body in self._free:
                 body.read()
 
+    def substep_recorder(self) -> Callable[[], None] | None:
+        """What to call after each physics substep of the coming control step, in place of
+        :meth:`record_substep`: the native fold itself (no Python in between), or None
+        when the native fold would do nothing (no free body, no scan this step)."""
+        if self._fold_native is None:
+            return self.record_substep
+        if not self._free and not (self._scan_on and self._filter):
+            return None
+        return self._fold_native
+
     def record_substep(self) -> None:
         """Fold the physics step just taken into the control step's maxima."""
         if self._fold_native is not None:

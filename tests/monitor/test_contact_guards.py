@@ -89,12 +89,17 @@ def test_guards_read_what_a_full_scan_reads(name, motion, monkeypatch):
         monitor.probe._scan = counted
     record, end = guarded.record_substep, guarded.end_step
     margins = []
+    native_record = []  # the native monitor's recorder for this control step, as an env asks for it
 
-    def record_both():
+    def recorder():
+        native_record[:] = [native.substep_recorder() if native is not None else None]
+        return record_all
+
+    def record_all():
         record()
         full.record_substep()
-        if native is not None:
-            native.record_substep()
+        if native_record[0] is not None:
+            native_record[0]()
 
     def end_both():
         report = end()
@@ -102,7 +107,7 @@ def test_guards_read_what_a_full_scan_reads(name, motion, monkeypatch):
                         native.end_step().margins if native is not None else report.margins))
         return report
 
-    guarded.record_substep, guarded.end_step = record_both, end_both
+    guarded.substep_recorder, guarded.end_step = recorder, end_both
     for action in actions:
         env.step(action)
     assert len(a) == len(b) == STEPS
@@ -138,11 +143,17 @@ def test_the_gate_closes_only_on_steps_with_nothing_to_read(name, motion):
     a, b, closed = [], [], []
     _record_readings(gated, a)
     _record_readings(ungated, b)
-    record, end = gated.record_substep, gated.end_step
+    recorder, end = gated.substep_recorder, gated.end_step
     margins = []
+    gated_record = []  # the gated monitor's recorder for this control step (None: nothing to record)
+
+    def recorder_both():
+        gated_record[:] = [recorder()]
+        return record_both
 
     def record_both():
-        record()
+        if gated_record[0] is not None:
+            gated_record[0]()
         ungated.record_substep()
 
     def end_both():
@@ -151,7 +162,7 @@ def test_the_gate_closes_only_on_steps_with_nothing_to_read(name, motion):
         margins.append((report.margins, ungated.end_step().margins))
         return report
 
-    gated.record_substep, gated.end_step = record_both, end_both
+    gated.substep_recorder, gated.end_step = recorder_both, end_both
     for action in actions:
         env.step(action)
     assert ungated.probe.scan and ungated.probe.read_last

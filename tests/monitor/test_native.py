@@ -84,3 +84,61 @@ def test_a_build_is_cached_and_reused():
     stamp = first.stat().st_mtime_ns
     assert build() == first and first.stat().st_mtime_ns == stamp
     assert not [p for p in first.parent.iterdir() if p.name.startswith(".contacts-")]  # no partial builds
+
+
+def _bound_or_skip():
+    bound = native_module.bound_calls()
+    if bound is None:
+        pytest.skip("the bound-call module cannot be built here (no compiler or no Python headers)")
+    return bound
+
+
+def test_a_bound_call_passes_its_bound_arguments():
+    import ctypes
+    import sys
+
+    bound, calls = _bound_or_skip(), []
+    callback = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_double, ctypes.c_int32)(
+        lambda handle, value, flag: calls.append((handle, value, flag)))
+    keep = object()
+    held = sys.getrefcount(keep)
+    call = bound.bind(ctypes.cast(callback, ctypes.c_void_p).value, 0xF5, 2.5, 7, keep)
+    assert sys.getrefcount(keep) == held + 1  # the owner of the handle lives as long as the call
+    assert call() is None and call() is None
+    assert calls == [(0xF5, 2.5, 7), (0xF5, 2.5, 7)]
+    with pytest.raises(TypeError):
+        call(1)
+    del call
+    assert sys.getrefcount(keep) == held
+
+
+def test_a_bound_call_refuses_a_null_function():
+    with pytest.raises(ValueError, match="null"):
+        _bound_or_skip().bind(0, 1, 0.0, 0, None)
+
+
+def test_missing_python_headers_are_reported_not_raised(tmp_path, monkeypatch):
+    monkeypatch.setattr(native_module.sysconfig, "get_paths", lambda: {"include": str(tmp_path)})
+    with pytest.raises(NativeUnavailable, match="python3-dev"):
+        native_module.build_bound(tmp_path)
+
+
+@pytest.mark.parametrize(("scenario", "folds"), [("handover_block", True), ("move_bowl_around_no_go", False)])
+def test_the_env_records_substeps_through_the_native_fold(scenario, folds):
+    """What the env calls after a substep is the reader's fold itself, and nothing when the
+    fold would do nothing. handover_block watches the block's net force (a free body);
+    move_bowl_around_no_go has no free body, and no robot link is near the bowl at home,
+    so the gate keeps the scan off."""
+    if native_library() is None:
+        pytest.skip("the native reader cannot be built here")
+    env = fsvla.make(scenario)
+    env.reset(seed=0)
+    probe = env.monitor.probe
+    assert bool(probe._free or (probe.scan and probe._filter)) == folds
+    recorder = env.monitor.substep_recorder()
+    if not folds:
+        assert recorder is None
+    else:
+        assert recorder is probe._fold_native
+        if native_module.bound_calls() is not None:
+            assert type(recorder).__name__ == "builtin_function_or_method"
