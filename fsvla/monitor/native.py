@@ -187,7 +187,9 @@ class NativeLibrary:
                 ("fsvla_reader_take_free", None, [p, f64p, ctypes.c_int32]),
                 ("fsvla_reader_take", i64, [p, u64, f64p, i64, ctypes.c_int32]),
                 ("fsvla_reader_read", i64, [p, u64, f64p, i64]),
-                ("fsvla_poses", None, [p, i64, p]),
+                ("fsvla_snapshot_new", p, [p, p, p, i64]), ("fsvla_snapshot_free", None, [p]),
+                ("fsvla_snapshot_buffers", None, [p, p, p, p, p, i64, p, p, i64, p]),
+                ("fsvla_snapshot_take", None, [p, f64, ctypes.c_int32]),
                 ("fsvla_entity_name", i64, [p, ctypes.c_char_p, i64])):
             function = getattr(lib, name)
             function.restype, function.argtypes = restype, argtypes
@@ -261,21 +263,73 @@ def native_library() -> NativeLibrary | None:
         return None
 
 
-class NativePoses:
-    """World poses of a fixed list of components (their pointers, as
-    :meth:`NativeLibrary.component` gives them), read in one call: the matrices SAPIEN's
-    ``entity_pose.to_transformation_matrix()`` gives, bit for bit."""
+class NativeSnapshot:
+    """A control step's reading in one native call (``fsvla_snapshot_take``): the poses of
+    a fixed list of components, the scan reader's maxima (then forgotten) and, if asked,
+    the last reader's current pairs. The poses are the matrices SAPIEN's
+    ``entity_pose.to_transformation_matrix()`` gives, bit for bit; the rest is what
+    :meth:`NativeReader.take` and :meth:`NativeReader.read` give one by one, at a
+    Python-to-C call each, which costs microseconds right after PhysX stepped."""
 
-    def __init__(self, library: NativeLibrary, pointers: Sequence[int]):
-        self._poses = library.lib.fsvla_poses
-        self._pointers = np.array(pointers, dtype=np.uint64)
-        self._address, self._n = self._pointers.ctypes.data, len(self._pointers)
+    def __init__(self, library: NativeLibrary, scan: NativeReader, last: NativeReader | None,
+                 pointers: Sequence[int]):
+        lib = self._lib = library.lib
+        self._scan, self._last = scan, last
+        components = np.array(pointers, dtype=np.uint64)
+        self._handle = lib.fsvla_snapshot_new(scan._handle, last._handle if last is not None else None,
+                                              components.ctypes.data, len(components))
+        self._poses = np.zeros((len(components), 4, 4), dtype=np.float32)  # copied out every step
+        self._counts = np.zeros(2, dtype=np.int64)
+        self._grown = (-1, -1)
+        self._point()
+        bound, address = bound_calls(), ctypes.cast(lib.fsvla_snapshot_take, ctypes.c_void_p).value
+        # the calls live only here, so they keep nothing (keeping self would be a cycle
+        # through a capsule, which the collector cannot see through)
+        self._calls = tuple(bound.bind(address, self._handle, 0.0, flag, None) if bound is not None
+                            else functools.partial(lib.fsvla_snapshot_take, self._handle, 0.0, flag)
+                            for flag in (0, 1))
 
-    def read(self) -> np.ndarray:
-        """A new (n, 4, 4) float32 array."""
-        out = np.empty((self._n, 4, 4), dtype=np.float32)
-        self._poses(self._address, self._n, out.ctypes.data)
-        return out
+    def _point(self) -> None:
+        """Tell the native side where the buffers are (again after a reader grew its own)."""
+        scan, last = self._scan, self._last
+        self._grown = (scan.grown, last.grown if last is not None else -1)
+        self._lib.fsvla_snapshot_buffers(
+            self._handle, self._poses.ctypes.data, scan._free_values.ctypes.data, scan._pairs.ctypes.data,
+            scan._values.ctypes.data, scan._rows, last._pairs.ctypes.data if last is not None else None,
+            last._values.ctypes.data if last is not None else None, last._rows if last is not None else 0,
+            self._counts.ctypes.data)
+
+    def __del__(self) -> None:
+        handle, self._handle = getattr(self, "_handle", None), None
+        if handle:
+            self._lib.fsvla_snapshot_free(handle)
+
+    def take(self, maxima: ContactMaxima, read_last: bool, inv_dt: float) -> tuple[
+            np.ndarray, dict[tuple[str, str], np.ndarray]]:
+        """(a new (n, 4, 4) float32 pose stack, the last substep's pair forces or {} unless
+        ``read_last``); the scan reader's maxima are added to ``maxima`` and forgotten."""
+        read_last = read_last and self._last is not None
+        scan = self._scan
+        if (scan.grown, self._last.grown if self._last is not None else -1) != self._grown:
+            self._point()  # a reader grew its buffers since (a take or read of its own)
+        self._calls[read_last]()
+        taken, read = self._counts.tolist()
+        if scan._free:
+            scan._free_rows(maxima)
+        if taken < 0:  # more pair rows than the buffers held: nothing was taken yet
+            scan._pair_rows(maxima, scan._call(self._lib.fsvla_reader_take, True))
+            self._point()
+        else:
+            scan._pair_rows(maxima, taken)
+        last: dict[tuple[str, str], np.ndarray] = {}
+        if read_last:
+            assert self._last is not None
+            if read < 0:
+                last = self._last.read(inv_dt)
+                self._point()
+            else:
+                last = self._last._read_rows(read, inv_dt)
+        return self._poses.copy(), last
 
 
 @dataclass(frozen=True)
@@ -326,6 +380,7 @@ class NativeReader:
         self._grow(_ROWS)
 
     def _grow(self, rows: int) -> None:
+        self.grown = getattr(self, "grown", -1) + 1  # a NativeSnapshot points at the buffers anew
         self._pairs = np.zeros(2 * rows, dtype=np.uint64)
         self._values = np.zeros(3 * rows)
         self._rows = rows
@@ -363,14 +418,21 @@ class NativeReader:
         (unless not ``clear``)."""
         if self._free:
             self._lib.fsvla_reader_take_free(self._handle, self._free_arg, clear)
-            values = self._free_values.tolist()
-            for i, frame in enumerate(self._free):
-                force, torque = values[2 * i], values[2 * i + 1]
-                if force >= 0.0:
-                    maxima.add_force(frame, NET, force)
-                if torque >= 0.0:
-                    maxima.add_torque(frame, NET, torque)
-        n = self._call(self._lib.fsvla_reader_take, clear)
+            self._free_rows(maxima)
+        self._pair_rows(maxima, self._call(self._lib.fsvla_reader_take, clear))
+
+    def _free_rows(self, maxima: ContactMaxima) -> None:
+        """Add the free bodies' maxima, as the native side wrote them, to ``maxima``."""
+        values = self._free_values.tolist()
+        for i, frame in enumerate(self._free):
+            force, torque = values[2 * i], values[2 * i + 1]
+            if force >= 0.0:
+                maxima.add_force(frame, NET, force)
+            if torque >= 0.0:
+                maxima.add_torque(frame, NET, torque)
+
+    def _pair_rows(self, maxima: ContactMaxima, n: int) -> None:
+        """Add the first ``n`` rows of pair maxima in the buffers to ``maxima``."""
         if not n:
             return
         pairs, values = self._pairs[:2 * n].tolist(), self._values[:3 * n].tolist()
@@ -387,7 +449,10 @@ class NativeReader:
     def read(self, inv_dt: float) -> dict[tuple[str, str], np.ndarray]:
         """Force on the first frame by the second, both orders, for the kept pairs of the
         current reports (the last substep)."""
-        n = self._call(self._lib.fsvla_reader_read)
+        return self._read_rows(self._call(self._lib.fsvla_reader_read), inv_dt)
+
+    def _read_rows(self, n: int, inv_dt: float) -> dict[tuple[str, str], np.ndarray]:
+        """:meth:`read`'s answer from the first ``n`` rows of pair impulses in the buffers."""
         if not n:
             return {}
         pairs = self._pairs[:2 * n].tolist()
@@ -404,5 +469,5 @@ class NativeReader:
         return n
 
 
-__all__ = ["FreeBodySpec", "NativeLibrary", "NativePoses", "NativeReader", "NativeUnavailable", "bound_calls", "build",
+__all__ = ["FreeBodySpec", "NativeLibrary", "NativeReader", "NativeSnapshot", "NativeUnavailable", "bound_calls", "build",
            "build_bound", "native_library"]

@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from .native import FreeBodySpec, NativePoses, NativeReader, NativeUnavailable, native_library
+from .native import FreeBodySpec, NativeReader, NativeSnapshot, NativeUnavailable, native_library
 from .state import NET, ContactMaxima, PoseMap, WorldState, link_frame, pair_key, robot_frame
 
 log = logging.getLogger(__name__)
@@ -208,7 +208,7 @@ class Probe:
         self._scan_on = True
         self.read_last = True  # snapshot(contacts=True) reads the last substep's contacts
         self.guards = True  # sleeping guard bodies spare the scans (off: every reading is taken)
-        self._native_scan, self._native_last, self._native_poses = (
+        self._native_scan, self._native_last, self._native_snapshot = (
             self._native_parts(g) if native else (None, None, None))
         self._fold_native = self._native_fold()
 
@@ -231,8 +231,9 @@ class Probe:
         return self._native_scan.folder(1.0 / self._dt, self._scan_on and bool(self._filter))
 
     def _native_parts(self, gravity: tuple[float, float, float]) -> tuple[
-            NativeReader | None, NativeReader | None, NativePoses | None]:
-        """(substep reader, last-substep reader, pose reader) in native code, or Nones."""
+            NativeReader | None, NativeReader | None, NativeSnapshot | None]:
+        """(substep reader, last-substep reader, the snapshot's reading of poses and of
+        both readers) in native code, or Nones."""
         library = native_library()
         if library is None:
             return None, None, None
@@ -244,11 +245,11 @@ class Probe:
                                 robot_pairs=self._filter.robot_pairs, torque=self._torque, free_bodies=free)
             last = NativeReader(library, system, pointers, any_pair=self._last.any_pair,
                                 robot_pairs=self._last.robot_pairs) if self._last else None
-            poses = NativePoses(library, [pointers[f] for f in self._pose_names]) if self._pose_names else None
+            snapshot = NativeSnapshot(library, scan, last, [pointers[f] for f in self._pose_names])
         except NativeUnavailable as error:
             log.info("reading this scene's contacts in Python: %s", error)
             return None, None, None
-        return scan, last, poses
+        return scan, last, snapshot
 
     @property
     def native(self) -> bool:
@@ -459,8 +460,6 @@ class Probe:
     def poses(self) -> PoseMap:
         if not self._pose_frames:
             return PoseMap((), np.zeros((0, 4, 4), dtype=np.float32))
-        if self._native_poses is not None:
-            return PoseMap(self._pose_names, self._native_poses.read(), self._pose_index)
         return PoseMap(self._pose_names, np.array([c.entity_pose.to_transformation_matrix()
                                                    for c in self._pose_components]), self._pose_index)
 
@@ -475,12 +474,15 @@ class Probe:
                 q = qpos[id(a)] = a.get_qpos()
             joints[k] = float(q[i])
         maxima, self.maxima = self.maxima, ContactMaxima()  # the state takes this step's maxima
-        if self._native_scan is not None:
-            self._native_scan.take(maxima)
+        read_last = contacts and self.read_last
+        if self._native_snapshot is not None:  # poses, maxima and last contacts in one call
+            stack, last = self._native_snapshot.take(maxima, read_last, 1.0 / self._dt)
+            poses = PoseMap(self._pose_names, stack, self._pose_index)
+        else:
+            poses, last = self.poses(), self.last_contacts() if read_last else {}
         self._scan_memo_counted = False
-        return WorldState(step=step, time=time, poses=self.poses(), joints=joints, contact_force=maxima.force,
-                          contact_torque=maxima.torque,
-                          last_contacts=self.last_contacts() if contacts and self.read_last else {},
+        return WorldState(step=step, time=time, poses=poses, joints=joints, contact_force=maxima.force,
+                          contact_torque=maxima.torque, last_contacts=last,
                           contacts_read=contacts or self.records_substeps)
 
 

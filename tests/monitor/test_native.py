@@ -15,6 +15,7 @@ from fsvla.experts import make_expert
 from fsvla.monitor import native as native_module
 from fsvla.monitor import probe as probe_module
 from fsvla.monitor.native import NativeUnavailable, build, native_library
+from fsvla.monitor.probe import ContactFilter, Probe
 
 pytestmark = pytest.mark.sim
 
@@ -142,3 +143,59 @@ def test_the_env_records_substeps_through_the_native_fold(scenario, folds):
         assert recorder is probe._fold_native
         if native_module.bound_calls() is not None:
             assert type(recorder).__name__ == "builtin_function_or_method"
+
+
+def _boxes_on_ground(count: int):
+    scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
+    scene.set_timestep(0.002)
+    builder = scene.create_actor_builder()
+    builder.add_box_collision(half_size=[1.0, 1.0, 0.05])
+    ground = builder.build_static(name="ground")
+    ground.set_pose(sapien.Pose([0, 0, -0.05]))
+    components = {"ground": ground.find_component_by_type(sapien.physx.PhysxRigidStaticComponent)}
+    for k in range(count):
+        builder = scene.create_actor_builder()
+        builder.add_box_collision(half_size=[0.04, 0.04, 0.04], density=500.0 + 100.0 * k)
+        box = builder.build(name=f"box{k}")
+        box.set_pose(sapien.Pose([0.2 * k - 0.4, 0.1 * k, 0.045], [0.9962, 0.0, 0.0, 0.0872]))
+        components[f"box{k}"] = box.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent)
+    return scene, components
+
+
+def test_the_one_call_snapshot_reads_what_the_python_reader_reads_even_past_its_buffers():
+    """Five boxes landing on the ground: five scanned pairs, five last-substep pairs, with
+    the native readers' buffers cut to one row, so the one-call snapshot overflows, grows
+    them and reads again. Its maxima, contacts and poses are the Python reader's."""
+    if native_library() is None:
+        pytest.skip("the native reader cannot be built here")
+    scene, components = _boxes_on_ground(5)
+    boxes = sorted(f for f in components if f != "ground")
+    ground = ContactFilter(any_pair=frozenset({"ground"}))
+    probes = [Probe(scene, 0.002, components, pose_frames=boxes, free_bodies=boxes[:2], scan=ground,
+                    last=ground, native=native) for native in (True, False)]
+    fast, slow = probes
+    assert fast.native and not slow.native
+    fast._native_scan._grow(1)
+    fast._native_last._grow(1)
+    for probe in probes:
+        probe.guards = False
+        probe.reset()
+    kept = []  # every step's poses, both readers: a later reading must not overwrite them
+    for step in range(1, 4):
+        for _ in range(25):
+            scene.step()
+            for probe in probes:
+                probe.record_substep()
+        ours, theirs = (p.snapshot(step, 0.05 * step, contacts=True) for p in probes)
+        assert len(theirs.contact_force) == 7  # five pairs with the ground, two net forces
+        assert ours.contact_force == theirs.contact_force
+        assert ours.contact_torque == theirs.contact_torque
+        assert ours.last_contacts.keys() == theirs.last_contacts.keys() and len(ours.last_contacts) == 10
+        for key, value in theirs.last_contacts.items():
+            np.testing.assert_array_equal(ours.last_contacts[key], value)
+        np.testing.assert_array_equal(ours.poses.stack, theirs.poses.stack)
+        kept.append((ours.poses.stack, theirs.poses.stack.copy()))
+    assert fast._native_scan._rows >= 5 and fast._native_last._rows >= 5  # both overflowed and grew
+    assert not np.array_equal(kept[0][1], kept[-1][1])  # the boxes moved
+    for ours, theirs in kept:
+        np.testing.assert_array_equal(ours, theirs)

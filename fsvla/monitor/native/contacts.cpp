@@ -341,6 +341,57 @@ void fsvla_poses(const uint64_t *components, int64_t n, float *out) {
   }
 }
 
+// One control step's reading in one call (Python's calls cost microseconds each right
+// after PhysX stepped): the poses, the scan reader's free-body and pair maxima (then
+// forgotten), and, if asked, the last reader's current pairs, into buffers the Python
+// side owns and points to with fsvla_snapshot_buffers. counts gets the pair rows taken
+// and the last pairs read; minus the count where a buffer was too small, and then that
+// part is neither written nor forgotten (the Python side grows it and asks again).
+struct Snapshot {
+  Reader *scan = nullptr, *last = nullptr;
+  std::vector<uint64_t> components;
+  float *poses = nullptr;
+  double *free_values = nullptr;
+  uint64_t *pairs = nullptr, *last_pairs = nullptr;
+  double *values = nullptr, *last_values = nullptr;
+  int64_t cap = 0, last_cap = 0;
+  int64_t *counts = nullptr;
+};
+
+void *fsvla_snapshot_new(void *scan, void *last, const uint64_t *components, int64_t n) {
+  auto *s = new Snapshot;
+  s->scan = static_cast<Reader *>(scan);
+  s->last = static_cast<Reader *>(last);
+  s->components.assign(components, components + n);
+  return s;
+}
+
+void fsvla_snapshot_free(void *snapshot) { delete static_cast<Snapshot *>(snapshot); }
+
+void fsvla_snapshot_buffers(void *snapshot, float *poses, double *free_values, uint64_t *pairs, double *values,
+                            int64_t cap, uint64_t *last_pairs, double *last_values, int64_t last_cap,
+                            int64_t *counts) {
+  auto *s = static_cast<Snapshot *>(snapshot);
+  s->poses = poses;
+  s->free_values = free_values;
+  s->pairs = pairs;
+  s->values = values;
+  s->cap = cap;
+  s->last_pairs = last_pairs;
+  s->last_values = last_values;
+  s->last_cap = last_cap;
+  s->counts = counts;
+}
+
+// The signature of a bound call (fsvla/monitor/native/bound.cpp); `unused` is not read.
+void fsvla_snapshot_take(void *snapshot, double unused, int32_t read_last) {
+  auto *s = static_cast<Snapshot *>(snapshot);
+  fsvla_poses(s->components.data(), static_cast<int64_t>(s->components.size()), s->poses);
+  fsvla_reader_take_free(s->scan, s->free_values, 1);
+  s->counts[0] = fsvla_reader_take(s->scan, s->pairs, s->values, s->cap, 1);
+  s->counts[1] = (read_last && s->last) ? fsvla_reader_read(s->last, s->last_pairs, s->last_values, s->last_cap) : 0;
+}
+
 // The name of a component's entity (for frames the monitor does not know), truncated to
 // cap - 1 bytes; returns its full length.
 int64_t fsvla_entity_name(const void *component, char *out, int64_t cap) {
