@@ -278,7 +278,7 @@ class SceneGeometry:
         if index is None:
             index = self._group_frames[frames] = np.array(
                 [self._frame_index[f] for f in frames if f in self._frame_index], dtype=np.int64)
-        return int(self._stamp[index].sum())
+        return kernels.stamp_total(self._stamp, index)
 
     def _group(self, frames: frozenset[str]) -> NDArray[np.int64]:
         found = self._groups.get(frames)
@@ -379,7 +379,7 @@ class SceneGeometry:
         if fresh and found[1] >= exact_below:  # far at the frame level already
             return found[1]
         ia, ib, frames, _ = self._pair(a, b)
-        version = found[0] if fresh else int(self._stamp[frames].sum())  # the prefetch summed these stamps
+        version = found[0] if fresh else kernels.stamp_total(self._stamp, frames)  # as the prefetch sums them
         cached = self._memo.get(key)
         if cached is not None and cached[2] == version and (cached[0] < cached[1] or cached[1] >= exact_below):
             return cached[0]

@@ -50,6 +50,23 @@ def test_empty_groups_and_moves():
     assert geometry.distance(A, B) == pytest.approx(-0.05, abs=1e-3)
 
 
+def test_a_group_version_changes_when_and_only_when_one_of_its_frames_moves():
+    geometry = SceneGeometry()
+    for name, x in (("a", 0.0), ("b", 0.3), ("c", 0.6)):
+        geometry.add(name, [SphereShape(radius=0.05)], _at(x))
+    ab = frozenset({"a", "b"})
+    geometry.set_poses({"a": _at(0.0)})
+    before = geometry.version(ab)
+    geometry.set_poses({"c": _at(0.7), "a": _at(POSE_TOLERANCE / 2)})  # c is not in the group; a jitters
+    assert geometry.version(ab) == before
+    geometry.set_poses({"b": _at(0.35)})
+    moved = geometry.version(ab)
+    assert moved > before
+    geometry.set_poses({"a": _at(0.1), "b": _at(0.4)})
+    assert geometry.version(ab) > moved
+    assert geometry.version(frozenset({"nothing"})) == 0
+
+
 def _pose(rng: np.random.Generator, centre: np.ndarray, turn: float) -> np.ndarray:
     """A random rotation of up to ``turn`` rad about a random axis, at ``centre``."""
     from scipy.spatial.transform import Rotation
