@@ -3,6 +3,7 @@ saying why, where it cannot be built."""
 
 from __future__ import annotations
 
+import functools
 import logging
 
 import numpy as np
@@ -162,12 +163,16 @@ def _boxes_on_ground(count: int):
     return scene, components
 
 
-def test_the_one_call_snapshot_reads_what_the_python_reader_reads_even_past_its_buffers():
+@pytest.mark.parametrize("bound", [True, False], ids=["bound", "ctypes"])
+def test_the_one_call_snapshot_reads_what_the_python_reader_reads_even_past_its_buffers(bound, monkeypatch):
     """Five boxes landing on the ground: five scanned pairs, five last-substep pairs, with
     the native readers' buffers cut to one row, so the one-call snapshot overflows, grows
-    them and reads again. Its maxima, contacts and poses are the Python reader's."""
+    them and reads again. Its maxima, contacts and poses are the Python reader's, whether
+    the native calls are bound in C or made through ctypes."""
     if native_library() is None:
         pytest.skip("the native reader cannot be built here")
+    if not bound:
+        monkeypatch.setattr(native_module, "bound_calls", lambda: None)
     scene, components = _boxes_on_ground(5)
     boxes = sorted(f for f in components if f != "ground")
     ground = ContactFilter(any_pair=frozenset({"ground"}))
@@ -175,6 +180,7 @@ def test_the_one_call_snapshot_reads_what_the_python_reader_reads_even_past_its_
                     last=ground, native=native) for native in (True, False)]
     fast, slow = probes
     assert fast.native and not slow.native
+    assert isinstance(fast._fold_native, functools.partial) != bound
     fast._native_scan._grow(1)
     fast._native_last._grow(1)
     for probe in probes:
