@@ -22,7 +22,7 @@ clears, so the same seed and actions give the identical trace in any episode.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, ClassVar
 
 import gymnasium
 import numpy as np
@@ -36,6 +36,7 @@ from fsvla.library import ScenarioRef, load_scenario
 from fsvla.monitor import SafetyMonitor
 from fsvla.sim.builder import BuiltScene, build
 from fsvla.sim.kinematics import ArmKinematics
+from fsvla.sim.robot import LoadedArm
 from fsvla.variation.apply import VisionApplier
 from fsvla.variation.language import Instruction, instruction_for
 from fsvla.variation.vision import VisionPerturbation, perturbation_for
@@ -66,7 +67,7 @@ class EnvConfig:
 class FsvlaEnv(gymnasium.Env):
     """A gymnasium environment for one scenario at one layout (level, seed)."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 20}
     built: BuiltScene
     monitor: SafetyMonitor | None
     _vision: VisionApplier | None
@@ -250,11 +251,11 @@ def _finite(values: tuple[float, ...], bound: float) -> list[float]:
     return [v if np.isfinite(v) else 100.0 * bound for v in values]
 
 
-def _layout(arm) -> ArmLayout:  # noqa: ANN001 - a LoadedArm
+def _layout(arm: LoadedArm) -> ArmLayout:
     joints = arm.articulation.active_joints
     limits = [joints[i].limit[0] for i in arm.joint_indices]
     return ArmLayout(arm.name, tuple(arm.spec.joints),
                      tuple(float(lo) for lo, _ in limits), tuple(float(hi) for _, hi in limits))
 
 
-__all__ = ["EnvConfig", "FsvlaEnv", "OBS_MODES"]
+__all__ = ["OBS_MODES", "EnvConfig", "FsvlaEnv"]
