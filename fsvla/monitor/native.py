@@ -378,10 +378,11 @@ class NativeReader:
                                       inertia, cmass_q, gravity)
         self._free_values = np.zeros(2 * max(len(self._free), 1))
         self._free_arg = self._free_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        self.grown = -1  # times the buffers were (re)made: a NativeSnapshot points at them anew
         self._grow(_ROWS)
 
     def _grow(self, rows: int) -> None:
-        self.grown = getattr(self, "grown", -1) + 1  # a NativeSnapshot points at the buffers anew
+        self.grown += 1
         self._pairs = np.zeros(2 * rows, dtype=np.uint64)
         self._values = np.zeros(3 * rows)
         self._rows = rows
