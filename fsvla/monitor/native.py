@@ -293,12 +293,16 @@ class NativeSnapshot:
     def _point(self) -> None:
         """Tell the native side where the buffers are (again after a reader grew its own)."""
         scan, last = self._scan, self._last
-        self._grown = (scan.grown, last.grown if last is not None else -1)
+        self._grown = self._generations()
         self._lib.fsvla_snapshot_buffers(
             self._handle, self._poses.ctypes.data, scan._free_values.ctypes.data, scan._pairs.ctypes.data,
             scan._values.ctypes.data, scan._rows, last._pairs.ctypes.data if last is not None else None,
             last._values.ctypes.data if last is not None else None, last._rows if last is not None else 0,
             self._counts.ctypes.data)
+
+    def _generations(self) -> tuple[int, int]:
+        """How many times each reader has made its buffers (-1 for no last reader)."""
+        return self._scan.grown, self._last.grown if self._last is not None else -1
 
     def __del__(self) -> None:
         handle, self._handle = getattr(self, "_handle", None), None
@@ -311,7 +315,7 @@ class NativeSnapshot:
         ``read_last``); the scan reader's maxima are added to ``maxima`` and forgotten."""
         read_last = read_last and self._last is not None
         scan = self._scan
-        if (scan.grown, self._last.grown if self._last is not None else -1) != self._grown:
+        if self._generations() != self._grown:
             self._point()  # a reader grew its buffers since (a take or read of its own)
         self._calls[read_last]()
         taken, read = self._counts.tolist()

@@ -223,12 +223,17 @@ class Probe:
             self._scan_on = on
             self._fold_native = self._native_fold()
 
+    @property
+    def _scanning(self) -> bool:
+        """Whether this control step's substeps fold kept pairs (the scan is on and keeps some)."""
+        return self._scan_on and bool(self._filter)
+
     def _native_fold(self) -> Callable[[], None] | None:
         """The native reader's fold of one substep with this probe's arguments bound (it runs
         25 times a control step: no Python between the call and the reader)."""
         if self._native_scan is None:
             return None
-        return self._native_scan.folder(1.0 / self._dt, self._scan_on and bool(self._filter))
+        return self._native_scan.folder(1.0 / self._dt, self._scanning)
 
     def _native_parts(self, gravity: tuple[float, float, float]) -> tuple[
             NativeReader | None, NativeReader | None, NativeSnapshot | None]:
@@ -287,7 +292,7 @@ class Probe:
         when the native fold would do nothing (no free body, no scan this step)."""
         if self._fold_native is None:
             return self.record_substep
-        if not self._free and not (self._scan_on and self._filter):
+        if not self._free and not self._scanning:
             return None
         return self._fold_native
 
@@ -299,7 +304,7 @@ class Probe:
         inv_dt = 1.0 / self._dt
         for body in self._free:
             body.record(self.maxima, inv_dt)
-        if self.scan and self._filter:
+        if self._scanning:
             slept = self._scan_slept
             self._scan_slept = asleep = self.guards and _asleep(self._scan_guard)
             if slept and asleep and self._scan_memo is not None:
