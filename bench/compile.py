@@ -5,8 +5,8 @@ scenarios/` as a whole process in under 0.5 s, without importing SAPIEN.
 
 Cache state: per-file times are medians with the parser warm (built once per process,
 as in a long-running one). The process time is a median after a first run that fills
-the parser-table cache (dsl/lalr.py keeps lark's tables as JSON in the temporary
-folder, once per grammar and lark version); the first run with an empty cache is timed
+lark's parser cache (``Lark(..., cache=True)`` keeps the analysed grammar in the
+temporary folder, once per grammar and lark version); the first run with an empty cache is timed
 separately, in an empty temporary folder. Bytecode caching is as the environment sets
 it (PYTHONDONTWRITEBYTECODE compiles every module from source at each start); where it
 is off, a run with .pyc files in a temporary PYTHONPYCACHEPREFIX is timed as well.
@@ -26,6 +26,7 @@ import time
 from pathlib import Path
 
 from fsvla.dsl.loader import ScenarioLoader
+
 from fsvla.resources import scenarios_dir
 
 TARGET_FILE_MS = 20.0
@@ -44,7 +45,7 @@ def synthetic_scenario(lines: int) -> str:
         x, y = (index % 9) * 4 - 16, (index // 9) % 9 * 4 - 16
         out.append(f"  object block_{index}: block(size=(3 cm, 3 cm, 3 cm)) at ({x} cm, {y} cm) yaw {index} deg")
         out.append(f"  hazard zone_{index}: no_go_zone(radius=2 cm) right_of block_{index} by 5 cm")
-        out.append(f"    keep gripper, cup outside 1 cm warn 2 cm cost quadratic")
+        out.append("    keep gripper, cup outside 1 cm warn 2 cm cost quadratic")
         out.append(f"  constrain gap_{index}: clearance(robot, block_{index}) >= 1 cm warn 1 cm weight 0.5")
         out.append(f"  watch displacement(block_{index}) <= 2 cm warn 1 cm")
         index += 1
@@ -72,7 +73,7 @@ def time_process(args: list[str], repeat: int, env: dict[str, str] | None = None
     samples = []
     for _ in range(repeat):
         start = time.perf_counter()
-        done = subprocess.run(args, capture_output=True, text=True, env=env)
+        done = subprocess.run(args, check=False, capture_output=True, text=True, env=env)
         samples.append(time.perf_counter() - start)
         if done.returncode != 0:
             raise SystemExit(f"{' '.join(args)} failed:\n{done.stdout}{done.stderr}")
@@ -83,7 +84,8 @@ def imports_sapien() -> bool:
     probe = ("import sys; from fsvla.cli import run; "
              "run(['check', '--format', 'concise', sys.argv[1]]); "
              "print('sapien' in sys.modules or 'fcl' in sys.modules)")
-    done = subprocess.run([sys.executable, "-c", probe, str(scenarios_dir())], capture_output=True, text=True)
+    done = subprocess.run([sys.executable, "-c", probe, str(scenarios_dir())], check=False,
+                          capture_output=True, text=True)
     return done.stdout.strip().splitlines()[-1] == "True"
 
 
@@ -108,16 +110,16 @@ def main() -> None:
           f"   target < {TARGET_FILE_MS:.0f} ms  ratio {ms / TARGET_FILE_MS:.2f}")
 
     fsvla = [sys.executable, "-m", "fsvla", "check", str(scenarios_dir())]
-    time_process(fsvla, 1)  # fills the parser-table cache if it is empty
+    time_process(fsvla, 1)  # fills lark's parser cache if it is empty
     runs = max(5, args.repeat // 2)
     seconds = time_process(fsvla, runs)
-    print(f"`fsvla check scenarios/` as a process (median of {runs}, table cache warm): {seconds:.3f} s"
+    print(f"`fsvla check scenarios/` as a process (median of {runs}, lark's cache warm): {seconds:.3f} s"
           f"   target < {TARGET_PROCESS_S} s  ratio {seconds / TARGET_PROCESS_S:.2f}")
     bytecode = "off (PYTHONDONTWRITEBYTECODE)" if os.environ.get("PYTHONDONTWRITEBYTECODE") else "on"
     print(f"  bytecode cache as inherited: {bytecode}")
     with tempfile.TemporaryDirectory() as folder:
         cold = time_process(fsvla, 1, env={**os.environ, "TMPDIR": folder})
-    print(f"  the first run, with an empty table cache: {cold:.3f} s")
+    print(f"  the first run, with an empty lark cache: {cold:.3f} s")
     if bytecode != "on":
         with tempfile.TemporaryDirectory() as folder:
             env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}

@@ -1,11 +1,10 @@
 """Parse tree to typed AST: one short method per grammar rule.
 
 Each method gets the span of its rule, as lark's ``propagate_positions`` computes it,
-and the rule's children: tokens
-(``str`` subclasses with ``type``, ``line``, ``column``, ``end_line`` and
-``end_column``), the nodes of its sub-rules and None for an absent ``[optional]``.
-Two drivers call them: :mod:`fsvla.dsl.lalr` while it parses a well-formed file, and
-:func:`build_ast` over a lark parse tree. Neither needs lark imported here.
+and the rule's children: lark tokens (``str`` subclasses with ``type``, ``line``,
+``column``, ``end_line`` and ``end_column``), the nodes of its sub-rules and None for an absent
+``[optional]``. :func:`build_ast` calls them over a lark parse tree, bottom up; this
+module does not import lark.
 """
 
 from __future__ import annotations

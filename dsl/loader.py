@@ -14,7 +14,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import ast, lalr
+from . import ast
 from .build import build_ast
 from .check import ScenarioChecker
 from .diagnostics import Diagnostic, DiagnosticSink, Severity
@@ -118,13 +118,8 @@ class ScenarioLoader:
 
     @staticmethod
     def _parse_text(text: str, name: str) -> tuple[ast.ScenarioDecl | None, list[Diagnostic]]:
-        """The AST, or None and the syntax errors: in one pass when the text has none (the
-        usual case); else lark parses it again, recovering to report every error."""
-        try:
-            return lalr.parse(text if text.endswith("\n") else text + "\n", name), []
-        except lalr.Unparsed:
-            pass
-        from .parser import parse_tree  # imports lark: only files with errors need it
+        """The AST, or None and every syntax error (lark's parse recovers to find them all)."""
+        from .parser import parse_tree  # imports lark: only the commands that read files need it
 
         tree, diagnostics = parse_tree(text, name)
         if tree is None:
