@@ -11,6 +11,7 @@ from fsvla.results.models import (
     FailureReason,
     layout_digest,
 )
+from fsvla.results.record import EpisodeRecord
 from fsvla.results.store import ResultStore, RunConfigMismatch, RunInfo, RunLocked
 from fsvla.results.traces import read_record, read_trace, read_trace_table, write_trace
 from fsvla.results.versions import collect_versions
@@ -18,6 +19,7 @@ from fsvla.results.versions import collect_versions
 __all__ = [
     "FAILURE_REASONS",
     "EpisodeOutcome",
+    "EpisodeRecord",
     "EpisodeRow",
     "FailureReason",
     "ResultStore",

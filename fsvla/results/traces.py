@@ -1,6 +1,6 @@
 """Per-step traces as Parquet: one file per episode, one row per control step.
 
-The data stored is an :class:`~fsvla.env.recording.EpisodeRecord`'s ``to_dict()``. Its
+The data stored is an :class:`~fsvla.results.record.EpisodeRecord`'s ``to_dict()``. Its
 per-step arrays become columns (row t = control step t + 1):
 
 ==================  =========  ====================================================
@@ -32,6 +32,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from fsvla.results.record import EpisodeRecord
 
 TRACE_FILE_FORMAT = 1
 METADATA_KEY = b"fsvla.trace"
@@ -139,31 +141,10 @@ def read_trace(path: Path) -> dict[str, Any]:
     return {key: record[key] for key in meta["keys"]}
 
 
-def record_from_dict(record: Mapping[str, Any]) -> Any:
-    """An :class:`~fsvla.env.recording.EpisodeRecord` from its ``to_dict()`` (imports it)."""
-    from fsvla.env.recording import EpisodeRecord
-    from fsvla.metrics.trace import ChannelInfo
-
-    channels = tuple(ChannelInfo.model_validate(c) for c in record["channels"])
-    labels = tuple(record["action_labels"])
-    steps, k = len(record["margins"]), len(channels)
-    return EpisodeRecord(
-        channels=channels,
-        action_labels=labels,
-        actions=np.array(record["actions"], dtype=np.float64).reshape(steps, len(labels)),
-        margins=np.array(record["margins"], dtype=np.float64).reshape(steps, k),
-        states=tuple(tuple(s) for s in record["states"]),
-        costs=np.array(record["costs"], dtype=np.float64).reshape(steps, k),
-        step_costs=np.array(record["step_costs"], dtype=np.float64).reshape(steps),
-        success_values=np.array(record["success_values"], dtype=bool).reshape(steps),
-        success=bool(record["success"]),
-    )
-
-
-def read_record(path: Path) -> Any:
-    """The :class:`~fsvla.env.recording.EpisodeRecord` stored in ``path``."""
-    return record_from_dict(read_trace(path))
+def read_record(path: Path) -> EpisodeRecord:
+    """The :class:`~fsvla.results.record.EpisodeRecord` stored in ``path``."""
+    return EpisodeRecord.from_dict(read_trace(path))
 
 
 __all__ = ["METADATA_KEY", "TRACE_FILE_FORMAT", "read_record", "read_trace", "read_trace_table",
-           "record_from_dict", "trace_metadata", "write_trace"]
+           "trace_metadata", "write_trace"]

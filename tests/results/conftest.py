@@ -9,10 +9,10 @@ from typing import Any
 import numpy as np
 import pytest
 
-from fsvla.env.recording import EpisodeRecord
 from fsvla.metrics.shaping import soft_cost
 from fsvla.metrics.trace import ChannelInfo
 from fsvla.results import EpisodeOutcome
+from fsvla.results.record import EpisodeRecord
 from fsvla.run import EpisodeSpec, PlannedScenario, RunConfig, plan_episodes
 from fsvla.variation.language import Instruction
 from fsvla.variation.vision import Lighting, VisionPerturbation
