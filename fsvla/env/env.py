@@ -154,11 +154,11 @@ class FsvlaEnv(gymnasium.Env):
         commands = self.codec.decode(action)
         self._stepped = True
         ik_errors = self._apply(commands)
-        record = self.monitor.substep_recorder() if self.monitor is not None else None
+        monitor = self.monitor
         for _ in range(self.substeps):
             self.built.step(1)
-            if record is not None:
-                record()
+            if monitor is not None:
+                monitor.record_substep()
         self._t += 1
         info: dict[str, Any] = {"step": self._t}
         success = violation = False

@@ -296,7 +296,7 @@ def warm_up() -> None:
     the first control step that needs one does not pay for it: a cold load costs ms."""
     poses, boxes, rows = np.tile(np.eye(4), (2, 1, 1)), np.zeros((2, 3)), np.zeros(2, dtype=np.int64)
     flags, values = np.zeros(2, dtype=np.bool_), np.zeros(2)
-    for stack in (poses.astype(np.float32), poses.copy()):  # the native reader's poses, the Python one's
+    for stack in (poses.astype(np.float32), poses.copy()):  # SAPIEN's float32 poses, hand-made float64 ones
         move_frames(stack, rows, poses.copy(), rows.copy(), 1e-5, rows, boxes, boxes, rows, boxes.copy(),
                     boxes.copy(), boxes.copy(), boxes.copy())
     update_bounds(poses, rows, boxes, boxes, rows, boxes.copy(), boxes.copy(), boxes.copy(), boxes.copy())

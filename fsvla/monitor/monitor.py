@@ -5,10 +5,8 @@ An env drives it in this order (dm_control's hooks: episode init, after substep,
     monitor = SafetyMonitor(monitor_spec, built)     # once per built scene
     built.reset(); monitor.reset()                   # t = 0
     for each control step:
-        record = monitor.substep_recorder()          # None: nothing to record this step
         for each of monitor.substeps physics steps:
-            built.step(1); record and record()       # force maxima, every substep
-                                                     # (monitor.record_substep() does the same)
+            built.step(1); monitor.record_substep()  # force maxima, every substep
         report = monitor.end_step()                  # margins, states, costs, success
     trace = monitor.trace(meta)                      # an fsvla.metrics EpisodeTrace
 
@@ -25,12 +23,13 @@ control step, and PhysX makes no contact beyond its contact offset (4 mm).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 from fsvla.compiler.monitor import MonitorSpec, RobotEntity
 from fsvla.compiler.scene import SceneSpec
 from fsvla.metrics.trace import EpisodeMeta, EpisodeTrace
+from fsvla.run.key import EpisodeKey
 
 from .contacts import CONTACT_GATE, ContactGate, contact_plan, predicate_filter
 from .evaluator import Evaluator
@@ -113,12 +112,6 @@ class SafetyMonitor:
         """Call after every physics substep: folds its contacts into the step's maxima."""
         self.probe.record_substep()
 
-    def substep_recorder(self) -> Callable[[], None] | None:
-        """The call to make after each physics substep of the coming control step (the same
-        as :meth:`record_substep`, with less in between), or None when there is nothing to
-        record in it. Ask again every control step: the contact gate changes it."""
-        return self.probe.substep_recorder()
-
     def end_step(self) -> StepReport:
         """Call after the control step's last substep: the step's report."""
         self._step += 1
@@ -133,9 +126,11 @@ class SafetyMonitor:
         return self.evaluator.trace(meta, success)
 
     def episode_meta(self, *, policy: str, seed: int, embodiment: str, **levels: Any) -> EpisodeMeta:
-        """EpisodeMeta with this scenario's name and suite filled in."""
-        return EpisodeMeta(scenario=self.spec.scenario, suite=self.spec.suite, embodiment=embodiment,
-                           seed=seed, policy=policy, **levels)
+        """EpisodeMeta with this scenario's name and suite filled in (``levels``: the key's
+        ``level``, ``language``, ``vision``, ``index``)."""
+        key = EpisodeKey(scenario=self.spec.scenario, suite=self.spec.suite, embodiment=embodiment,
+                         seed=seed, **levels)
+        return EpisodeMeta(key=key, policy=policy)
 
 
 __all__ = ["CONTACT_GATE", "SafetyMonitor"]

@@ -5,8 +5,6 @@ predicates) while every body its kept pairs must involve sleeps (``fsvla.monitor
 Here each built-in scenario runs the benchmark's ``reach`` and ``sweep`` motions with two
 monitors on one scene, one with the guards and one reading every contact; their force
 maxima, last-substep contacts and margins must be bit-identical at every control step.
-Both read contacts in Python (the guards belong to that reader); a third monitor on the
-native reader, where it can be built, must read the same numbers, bit for bit.
 """
 
 from __future__ import annotations
@@ -23,8 +21,6 @@ pytest.importorskip("sapien")
 import fsvla
 from fsvla.library import builtin_scenarios
 from fsvla.monitor import SafetyMonitor
-from fsvla.monitor import probe as probe_module
-from fsvla.monitor.native import native_library
 
 pytestmark = pytest.mark.sim
 STEPS = 130  # one reach cycle (6 s) and a little more
@@ -57,72 +53,47 @@ def _record_readings(monitor: SafetyMonitor, into: list) -> None:
 
 @pytest.mark.parametrize("motion", ["reach", "sweep"])
 @pytest.mark.parametrize("name", sorted(builtin_scenarios()))
-def test_guards_read_what_a_full_scan_reads(name, motion, monkeypatch):
+def test_guards_read_what_a_full_scan_reads(name, motion):
     env = fsvla.make(name, monitor=True)
     actions = _motions()[motion](env, STEPS)
-    library = native_library()
     env.reset()
-    monkeypatch.setattr(probe_module, "native_library", lambda: None)
-    guarded = env.monitor = SafetyMonitor(env.monitor_spec, env.built)  # the one the env drives
-    guarded.reset()
+    guarded = env.monitor  # the one the env drives
     full = SafetyMonitor(env.monitor_spec, env.built)
     full.probe.guards = False
     full.reset()
-    monkeypatch.setattr(probe_module, "native_library", lambda: library)
-    native = SafetyMonitor(env.monitor_spec, env.built) if library is not None else None
-    if native is not None:
-        assert native.probe.native and not guarded.probe.native
-        native.reset()
-    a, b, c = [], [], []
+    a, b = [], []
     _record_readings(guarded, a)
     _record_readings(full, b)
-    if native is not None:
-        _record_readings(native, c)
     scans = {guarded: 0, full: 0}
     for monitor in scans:
-        scan = monitor.probe._scan
+        read = monitor.probe._read_scan
 
-        def counted(inv_dt, scan=scan, monitor=monitor):
+        def counted(inv_dt, read=read, monitor=monitor):
             scans[monitor] += 1
-            return scan(inv_dt)
+            return read(inv_dt)
 
-        monitor.probe._scan = counted
+        monitor.probe._read_scan = counted
     record, end = guarded.record_substep, guarded.end_step
     margins = []
-    native_record = []  # the native monitor's recorder for this control step, as an env asks for it
 
-    def recorder():
-        native_record[:] = [native.substep_recorder() if native is not None else None]
-        return record_all
-
-    def record_all():
+    def record_both():
         record()
         full.record_substep()
-        if native_record[0] is not None:
-            native_record[0]()
 
     def end_both():
         report = end()
-        margins.append((report.margins, full.end_step().margins,
-                        native.end_step().margins if native is not None else report.margins))
+        margins.append((report.margins, full.end_step().margins))
         return report
 
-    guarded.substep_recorder, guarded.end_step = recorder, end_both
+    guarded.record_substep, guarded.end_step = record_both, end_both
     for action in actions:
         env.step(action)
     assert len(a) == len(b) == STEPS
     for step, (x, y) in enumerate(zip(a, b)):
         assert x == y, (name, motion, step)
-    for step, (x, y, z) in enumerate(margins, start=1):
-        assert np.array_equal(x, y), (name, motion, step)
-        np.testing.assert_array_equal(z, x, err_msg=f"{name} {motion} step {step}")
+    for step, (x, y) in enumerate(margins, start=1):
+        np.testing.assert_array_equal(x, y, err_msg=f"{name} {motion} step {step}")
     assert scans[guarded] <= scans[full]
-    for step, (x, z) in enumerate(zip(a, c)):  # the native reader's maxima and contacts
-        for ours, theirs in zip(z, x):
-            assert ours.keys() == theirs.keys(), (name, motion, step)
-            for key, value in theirs.items():
-                np.testing.assert_array_equal(ours[key], value,
-                                           err_msg=f"{name} {motion} step {step} {key}")
 
 
 @pytest.mark.parametrize("motion", ["reach", "sweep"])
@@ -143,17 +114,11 @@ def test_the_gate_closes_only_on_steps_with_nothing_to_read(name, motion):
     a, b, closed = [], [], []
     _record_readings(gated, a)
     _record_readings(ungated, b)
-    recorder, end = gated.substep_recorder, gated.end_step
+    record, end = gated.record_substep, gated.end_step
     margins = []
-    gated_record = []  # the gated monitor's recorder for this control step (None: nothing to record)
-
-    def recorder_both():
-        gated_record[:] = [recorder()]
-        return record_both
 
     def record_both():
-        if gated_record[0] is not None:
-            gated_record[0]()
+        record()
         ungated.record_substep()
 
     def end_both():
@@ -162,7 +127,7 @@ def test_the_gate_closes_only_on_steps_with_nothing_to_read(name, motion):
         margins.append((report.margins, ungated.end_step().margins))
         return report
 
-    gated.substep_recorder, gated.end_step = recorder_both, end_both
+    gated.record_substep, gated.end_step = record_both, end_both
     for action in actions:
         env.step(action)
     assert ungated.probe.scan and ungated.probe.read_last

@@ -40,22 +40,20 @@ def _scene():
     return scene, box, rigid, ground_rigid
 
 
-@pytest.mark.parametrize("native", [True, False], ids=["native", "python"])
 @pytest.mark.parametrize("path", ["net", "pairs"])
-def test_a_force_in_one_substep_reaches_the_control_step(path, native):
+def test_a_force_in_one_substep_reaches_the_control_step(path):
     scene, box, rigid, ground = _scene()
     box.set_pose(sapien.Pose([0, 0, 0.053]))  # 3 mm up: lands inside the control step
     components = {"box": rigid, "ground": ground}
     ground_pairs = ContactFilter(any_pair=frozenset({"ground"}))
     kw = {"free_bodies": ["box"]} if path == "net" else {"scan": ground_pairs, "last": ground_pairs}
-    probe = Probe(scene, DT, components, native=native, **kw)
-    assert probe.native == native
+    probe = Probe(scene, DT, components, **kw)
     probe.reset()
     per_substep = []
     for _ in range(25):
         scene.step()
         probe.record_substep()
-        per_substep.append(max(probe.maxima_so_far().force.values(), default=0.0))
+        per_substep.append(max(probe.maxima.force.values(), default=0.0))
     last = probe.last_contacts() if path == "pairs" else None
     snapshot = probe.snapshot(1, 0.05)
     peak = snapshot.contact_force[pair_key("box", NET if path == "net" else "ground")]
@@ -65,17 +63,16 @@ def test_a_force_in_one_substep_reaches_the_control_step(path, native):
     if last is not None:  # the last substep alone sees the box resting
         assert np.linalg.norm(last[("box", "ground")]) == pytest.approx(weight, rel=0.05)
     assert snapshot.max_force(frozenset({"box"})) == pytest.approx(peak)
-    assert probe.maxima_so_far().force == {}  # cleared for the next control step
+    assert probe.maxima.force == {}  # cleared for the next control step
 
 
-@pytest.mark.parametrize("native", [True, False], ids=["native", "python"])
-def test_net_and_pair_forces_agree_on_a_resting_box(native):
+def test_net_and_pair_forces_agree_on_a_resting_box():
     scene, box, rigid, ground = _scene()
     box.set_pose(sapien.Pose([0, 0, 0.05]))
     for _ in range(50):
         scene.step()
     probe = Probe(scene, DT, {"box": rigid, "ground": ground}, free_bodies=["box"], torque_frames=["box"],
-                  scan=ContactFilter(any_pair=frozenset({"ground"})), native=native)
+                  scan=ContactFilter(any_pair=frozenset({"ground"})))
     probe.reset()
     for _ in range(5):
         scene.step()
@@ -86,8 +83,7 @@ def test_net_and_pair_forces_agree_on_a_resting_box(native):
     assert s.contact_torque[("box", NET)] < 1e-3
 
 
-@pytest.mark.parametrize("native", [True, False], ids=["native", "python"])
-def test_a_pair_force_sums_the_contacts_of_every_shape_pair(native):
+def test_a_pair_force_sums_the_contacts_of_every_shape_pair():
     """A box of two halves resting on the ground: two contacts, one per half, and the
     pair's force is their sum (the weight), as the net force says, not the larger half."""
     scene, _, _, ground = _scene()
@@ -100,7 +96,7 @@ def test_a_pair_force_sums_the_contacts_of_every_shape_pair(native):
     for _ in range(50):
         scene.step()
     probe = Probe(scene, DT, {"halves": rigid, "ground": ground}, free_bodies=["halves"],
-                  torque_frames=["halves"], scan=ContactFilter(any_pair=frozenset({"ground"})), native=native)
+                  torque_frames=["halves"], scan=ContactFilter(any_pair=frozenset({"ground"})))
     probe.reset()
     for _ in range(5):
         scene.step()
