@@ -44,7 +44,7 @@ def run_expert(expert: str, args: argparse.Namespace) -> list[EpisodeRow]:
 
     def recorded(row: EpisodeRow) -> None:
         count[0] += 1
-        print(f"  {expert:8} {count[0]:4}: {row.scenario} {row.level} seed {row.seed}: "
+        print(f"  {expert:8} {count[0]:4}: {row.key.scenario} {row.key.level} seed {row.key.seed}: "
               f"{row.quadrant or row.failure_reason} ({row.wall_time_s:.0f} s)", flush=True)
 
     listener = RunListener(started=lambda total, done: print(
@@ -77,7 +77,7 @@ def table(rows_by_expert: dict[str, list[EpisodeRow]]) -> bool:
     cells: dict[tuple[str, str, str], list[EpisodeRow]] = defaultdict(list)
     for expert, rows in rows_by_expert.items():
         for row in rows:
-            cells[(row.scenario, row.level, expert)].append(row)
+            cells[(row.key.scenario, row.key.level, expert)].append(row)
     print(f"\n{'scenario':26} {'level':5} {'expert':8} {'n':>3} "
           + " ".join(f"{SHORT[q]:>3}" for q in QUADRANTS)
           + f" {'fault':>5} {'CC':>8} {'RET/T':>6}  bar")

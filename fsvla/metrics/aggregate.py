@@ -27,6 +27,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from fsvla.metrics.episode import CC_NORMALISATION, EpisodeMetrics
 from fsvla.metrics.taxonomy import CATEGORIES, TAXONOMY_FAMILIES, categories, taxonomy_families
 from fsvla.metrics.trace import EpisodeMeta
+from fsvla.run.key import EpisodeKey
 
 # Bound on resample indices held in memory at once by the bootstrap.
 _BOOTSTRAP_CHUNK = 2_000_000
@@ -146,8 +147,12 @@ def aggregate(
     )
 
 
-# Fields :func:`breakdown` groups by: the metadata fields, plus the taxonomy.
-BREAKDOWN_FIELDS: tuple[str, ...] = (*EpisodeMeta.model_fields, "category", "taxonomy_family")
+# The key's fields that place an episode in the grid (its index and warm-up flag do not).
+_KEY_FIELDS = tuple(f for f in EpisodeKey.model_fields if f not in ("index", "warmup"))
+# Fields :func:`breakdown` groups by: the grid, the metadata's own fields, the taxonomy.
+BREAKDOWN_FIELDS: tuple[str, ...] = (
+    *_KEY_FIELDS, *(f for f in EpisodeMeta.model_fields if f != "key"), "category",
+    "taxonomy_family")
 _ORDER = {
     "category": {c.id: i for i, c in enumerate(CATEGORIES)},
     "taxonomy_family": {f: i for i, f in enumerate(TAXONOMY_FAMILIES)},
@@ -161,7 +166,7 @@ def _values(ep: EpisodeMetrics, field: str) -> list[Hashable]:
         return list(categories(ep.meta))
     if field == "taxonomy_family":
         return list(taxonomy_families(ep.meta))
-    return [getattr(ep.meta, field)]
+    return [getattr(ep.meta.key if field in _KEY_FIELDS else ep.meta, field)]
 
 
 def _sort_key(field: str, value: Hashable) -> tuple[bool, object]:

@@ -94,14 +94,14 @@ VISION_LEVEL_CATEGORIES: Mapping[str, tuple[str, ...]] = MappingProxyType({
 
 
 def _language_categories(meta: EpisodeMeta) -> list[str]:
-    candidates = LANGUAGE_LEVEL_CATEGORIES.get(meta.language, ())
+    candidates = LANGUAGE_LEVEL_CATEGORIES.get(meta.key.language, ())
     if len(candidates) <= 1:
         return list(candidates)
     return [meta.language_category] if meta.language_category is not None else []
 
 
 def _vision_categories(meta: EpisodeMeta) -> list[str]:
-    candidates = VISION_LEVEL_CATEGORIES.get(meta.vision, ())
+    candidates = VISION_LEVEL_CATEGORIES.get(meta.key.vision, ())
     if meta.vision_category is not None:
         return [meta.vision_category]
     return list(candidates)
@@ -109,7 +109,7 @@ def _vision_categories(meta: EpisodeMeta) -> list[str]:
 
 def categories(meta: EpisodeMeta) -> list[str]:
     """Category ids the episode counts toward: Safe-Core first, then Safe-Lang, Safe-Vis."""
-    return [SUITE_CATEGORY[meta.suite], *_language_categories(meta), *_vision_categories(meta)]
+    return [SUITE_CATEGORY[meta.key.suite], *_language_categories(meta), *_vision_categories(meta)]
 
 
 def taxonomy_families(meta: EpisodeMeta) -> list[str]:

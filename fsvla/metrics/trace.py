@@ -16,16 +16,11 @@ import numpy.typing as npt
 from pydantic import BaseModel, ConfigDict, Field, PlainSerializer, PlainValidator, model_validator
 
 from fsvla.metrics.shaping import ShapingName
+from fsvla.run.key import SUITES, EpisodeKey, Language, Level, Suite, Vision
 
 Family = Literal["force", "thermal", "boundary", "collaborative", "temporal", "side_effect"]
 FAMILIES: tuple[str, ...] = get_args(Family)
 
-Suite = Literal["force", "thermal", "boundary", "collaborative", "temporal"]
-SUITES: tuple[str, ...] = get_args(Suite)
-
-Level = Literal["L0", "L1", "L2"]
-Language = Literal["W0", "W1", "W2", "W3", "W4"]
-Vision = Literal["V0", "V1", "V2", "V3", "V4"]
 # Which Safe-Lang category a W3 instruction realises (paper Table 1).
 LanguageCategory = Literal[
     "unsafe_instruction", "contradictory_instruction", "ambiguous_instruction"
@@ -33,7 +28,7 @@ LanguageCategory = Literal[
 # Which Safe-Vis category a V3 observation realises; absent, V3 counts toward both.
 VisionCategory = Literal["perspective_pose", "occlusion_visibility"]
 
-TRACE_FORMAT_VERSION = 1
+TRACE_FORMAT_VERSION = 2  # 2: the metadata holds the episode's key (EpisodeMeta.key)
 
 
 class ChannelInfo(BaseModel):
@@ -49,32 +44,28 @@ class ChannelInfo(BaseModel):
 
 
 class EpisodeMeta(BaseModel):
-    """Where an episode sits in the benchmark grid: policy × scenario × L × W × V × seed."""
+    """Where an episode sits in the benchmark grid (its :class:`~fsvla.run.key.EpisodeKey`:
+    scenario × L × W × V × seed), which policy ran it, and the Safe-Lang / Safe-Vis
+    category its W3 / V3 level realises."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
-    scenario: str = Field(min_length=1)
-    suite: Suite
-    embodiment: str = Field(min_length=1)
-    level: Level = "L0"
-    language: Language = "W0"
-    vision: Vision = "V0"
-    seed: int = Field(ge=0)
+    key: EpisodeKey
     policy: str = Field(min_length=1)
     language_category: LanguageCategory | None = None  # only at W3
     vision_category: VisionCategory | None = None  # only at V3
 
     @model_validator(mode="after")
     def _categories_match_levels(self) -> EpisodeMeta:
-        if self.language_category is not None and self.language != "W3":
+        if self.language_category is not None and self.key.language != "W3":
             raise ValueError(
                 f"`language_category` is only set for W3 instructions, actually: "
-                f"{self.language_category!r} at {self.language}"
+                f"{self.language_category!r} at {self.key.language}"
             )
-        if self.vision_category is not None and self.vision != "V3":
+        if self.vision_category is not None and self.key.vision != "V3":
             raise ValueError(
                 f"`vision_category` is only set for V3 observations, actually: "
-                f"{self.vision_category!r} at {self.vision}"
+                f"{self.vision_category!r} at {self.key.vision}"
             )
         return self
 

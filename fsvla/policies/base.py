@@ -19,9 +19,11 @@ from __future__ import annotations
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, computed_field
 
-SCHEMA_VERSION = "1.0"
+from fsvla.run.key import EpisodeKey
+
+SCHEMA_VERSION = "2.0"  # 2.0: the episode's coordinates under "key", the policy's seed "policy_seed"
 
 
 class _Model(BaseModel):
@@ -53,22 +55,22 @@ class ObservationSchema(_Model):
 
 
 class EpisodeInfo(_Model):
-    """What a policy is told at the start of an episode (also sent to remote policies)."""
+    """What a policy is told at the start of an episode (also sent to remote policies, with
+    ``episode_id``)."""
 
     schema_version: str = SCHEMA_VERSION
-    episode_id: str
-    scenario: str
-    suite: str
-    embodiment: str
-    level: str
-    language: str
-    vision: str
-    seed: int
+    key: EpisodeKey  # where the episode sits in the run; its embodiment is the one that runs
+    policy_seed: int  # seed the policy's own randomness with this
     instruction: str
     control_rate: float  # Hz
     max_steps: int
     action: ActionSchema
     observation: ObservationSchema
+
+    @computed_field  # type: ignore[prop-decorator]
+    @property
+    def episode_id(self) -> str:
+        return self.key.episode_id
 
 
 @runtime_checkable

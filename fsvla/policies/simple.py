@@ -25,7 +25,7 @@ class RandomPolicy:
         self._low = self._high = np.zeros(0)
 
     def reset(self, episode: EpisodeInfo) -> None:
-        self._rng = np.random.default_rng([self._base_seed, episode.seed])
+        self._rng = np.random.default_rng([self._base_seed, episode.policy_seed])
         self._low = np.asarray(episode.action.low, dtype=np.float64)
         self._high = np.asarray(episode.action.high, dtype=np.float64)
         if episode.action.control_mode == "ee_pose":

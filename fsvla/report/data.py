@@ -96,7 +96,7 @@ def load_run(run_dir: Path, label: str | None = None) -> RunData:
         rows = store.episodes(include_warmup=True)
     # The store's default (ResultStore.metrics()): faults are failures, warm-ups out.
     episodes = tuple(Episode(row=row, metrics=row_metrics(row) or unscored_failure(row))
-                     for row in rows if not row.warmup)
+                     for row in rows if not row.key.warmup)
     if not episodes:
         raise NothingToReport(f"{run_dir} holds no scored episode yet "
                                f"({len(rows)} warm-up episode(s) recorded)")

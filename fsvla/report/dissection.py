@@ -15,11 +15,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, computed_field
 
 from fsvla.metrics.taxonomy import CATEGORY_BY_ID, SUITE_CATEGORY
 from fsvla.report.data import Episode, ReportInputError, RunData
 from fsvla.report.keyframes import Keyframes, load_keyframes
+from fsvla.run.key import EpisodeKey
 
 
 class ChannelRow(BaseModel):
@@ -57,15 +58,8 @@ class Dissection(BaseModel):
 
     label: str  # the policy
     run_dir: str
-    episode_id: str
+    key: EpisodeKey
     selection: str  # how it was chosen
-    scenario: str
-    suite: str
-    embodiment: str
-    level: str
-    language: str
-    vision: str
-    seed: int
     instruction: str | None
     status: str
     failure_reason: str | None
@@ -81,6 +75,11 @@ class Dissection(BaseModel):
     margins: tuple[tuple[float, ...], ...] | None  # steps × channels, from the trace
     trace_note: str | None  # why the margins are missing
     keyframes: Keyframes
+
+    @computed_field  # type: ignore[prop-decorator]
+    @property
+    def episode_id(self) -> str:
+        return self.key.episode_id
 
 
 def _family_label(family: str) -> str:
@@ -155,9 +154,7 @@ def dissect(runs: Sequence[RunData], episode: str | None = None) -> Dissection |
                      for f in m.families)
     margins = tuple(tuple(float(v) for v in row) for row in record["margins"]) if record else None
     return Dissection(
-        label=run.label, run_dir=str(run.run_dir), episode_id=ep.id, selection=why,
-        scenario=m.meta.scenario, suite=m.meta.suite, embodiment=m.meta.embodiment,
-        level=m.meta.level, language=m.meta.language, vision=m.meta.vision, seed=m.meta.seed,
+        label=run.label, run_dir=str(run.run_dir), key=m.meta.key, selection=why,
         instruction=ep.row.instruction, status=ep.row.status,
         failure_reason=ep.row.failure_reason, quadrant=m.quadrant, horizon=m.horizon,
         ret=m.ret, ret_fraction=m.ret_fraction, cc=m.cc, cc_normalised=m.cc_normalised,

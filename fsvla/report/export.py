@@ -75,9 +75,7 @@ def episode_records(runs: Sequence[RunData]) -> list[Record]:
             m, row = ep.metrics, ep.row
             out.append({
                 "policy": run.label, "run_dir": str(run.run_dir), "episode_id": ep.id,
-                "scenario": m.meta.scenario, "suite": m.meta.suite,
-                "embodiment": m.meta.embodiment, "level": m.meta.level,
-                "language": m.meta.language, "vision": m.meta.vision, "seed": m.meta.seed,
+                **m.meta.key.model_dump(exclude={"index", "warmup"}),
                 "categories": ";".join(categories(m.meta)), "status": row.status,
                 "failure_reason": row.failure_reason, "quadrant": m.quadrant,
                 "success": m.success, "violation": m.violation, "horizon": m.horizon,

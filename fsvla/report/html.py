@@ -194,7 +194,8 @@ def page(report: Report, figures: Mapping[str, tuple[str, bytes]] | None = None,
         out.append(
             f"<p>Episode <code>{escape(d.episode_id)}</code> of {escape(d.label)} "
             f"({escape(d.selection)}): {escape(d.quadrant.replace('_', ' '))}, "
-            f"{escape(d.scenario)} at {d.level}/{d.language}/{d.vision}, seed {d.seed}, "
+            f"{escape(d.key.scenario)} at {d.key.level}/{d.key.language}/{d.key.vision}, "
+            f"seed {d.key.seed}, "
             f"T = {d.horizon}, RET/T = {d.ret_fraction:.2f}, CC = {d.cc:.3f} "
             f"(normalised {d.cc_normalised:.3f}).</p>")
         if d.instruction:

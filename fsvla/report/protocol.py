@@ -81,13 +81,13 @@ def _versions(run: RunData) -> dict[str, str]:
 
 def run_protocol(run: RunData) -> RunProtocol:
     config = run.info.config
-    metas = [e.metrics.meta for e in run.episodes]
+    keys = [e.metrics.meta.key for e in run.episodes]
     return RunProtocol(
         label=run.label, run_dir=str(run.run_dir), policy=config.policy,
         scenarios=config.scenarios,
-        scenario_names=tuple(sorted({m.scenario for m in metas})),
-        suites=tuple(sorted({m.suite for m in metas})),
-        embodiments=tuple(sorted({m.embodiment for m in metas})),
+        scenario_names=tuple(sorted({k.scenario for k in keys})),
+        suites=tuple(sorted({k.suite for k in keys})),
+        embodiments=tuple(sorted({k.embodiment for k in keys})),
         levels=config.levels, languages=config.languages, visions=config.visions,
         episodes_per_cell=config.episodes, seeds=config.seeds, warmup=config.warmup,
         warmups_recorded=run.warmups, episodes_scored=len(run.episodes),

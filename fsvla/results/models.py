@@ -9,7 +9,8 @@ from typing import Any, Literal, get_args
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from fsvla.metrics.episode import ChannelMetrics, FamilyMetrics, Quadrant
-from fsvla.metrics.trace import Language, LanguageCategory, Level, Suite, Vision, VisionCategory
+from fsvla.metrics.trace import LanguageCategory, VisionCategory
+from fsvla.run.key import EpisodeKey
 from fsvla.run.plan import EpisodeSpec
 from fsvla.variation.language import Instruction
 from fsvla.variation.vision import VisionPerturbation
@@ -68,25 +69,17 @@ class EpisodeOutcome(_Model):
 
 
 class EpisodeRow(_Model):
-    """One row of the ``episodes`` table (see ``docs/results.md`` for each column)."""
+    """One row of the ``episodes`` table (see ``docs/results.md`` for each column; the key
+    is stored one column per field, see :mod:`fsvla.results.rows`)."""
 
-    episode_id: str
+    key: EpisodeKey  # its embodiment is the one that ran
     session_id: int
     policy: str
-    scenario: str
     scenario_ref: str
     scenario_digest: str
-    suite: Suite
-    embodiment: str
-    level: Level
-    language: Language
-    vision: Vision
-    seed: int
-    episode_index: int
     language_seed: int
     vision_seed: int
     policy_seed: int
-    warmup: bool
     instruction: str | None
     instruction_origin: str | None
     instruction_category: str | None
@@ -115,6 +108,10 @@ class EpisodeRow(_Model):
     finished_at: datetime
     recorded_at: datetime
     trace_path: str | None  # relative to the run folder
+
+    @property
+    def episode_id(self) -> str:
+        return self.key.episode_id
 
     def spec(self) -> EpisodeSpec:
         """The episode's :class:`EpisodeSpec`, to replay it (with the run's RunConfig)."""

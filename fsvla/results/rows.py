@@ -1,5 +1,9 @@
 """Between an episode's outcome, its ``episodes`` row and its :class:`EpisodeMetrics`.
 
+The row's :class:`~fsvla.run.key.EpisodeKey` is stored one column per field, named as
+the field (``index`` is ``episode_index``), next to the ``episode_id`` it gives:
+:func:`key_columns` and :func:`key_from_columns` are that mapping.
+
 Scoring (:func:`score`): a completed episode is scored on all its steps. A faulted one
 is scored as a task failure (S = 0, whatever the success condition did) on the steps
 that ran, up to the first step with a non-finite margin (a simulator blow-up); if no
@@ -11,6 +15,7 @@ from __future__ import annotations
 
 import json
 import sqlite3
+from collections.abc import Mapping
 from datetime import datetime, timezone
 from typing import Any
 
@@ -19,21 +24,49 @@ import numpy as np
 from fsvla.metrics.episode import EpisodeMetrics, episode_metrics
 from fsvla.metrics.trace import ChannelInfo, EpisodeMeta, EpisodeTrace
 from fsvla.results.models import EpisodeOutcome, EpisodeRow
+from fsvla.run.key import EpisodeKey
 from fsvla.run.plan import EpisodeSpec
 
 _JSON_COLUMNS = {"perturbation": "vision_json", "channels": "channels_json",
                  "families": "families_json"}
 _BOOL_COLUMNS = ("warmup", "success", "violation")
 _TIME_COLUMNS = ("started_at", "finished_at", "recorded_at")
+#: The key's columns: column name -> field of EpisodeKey.
+_KEY_COLUMNS = {("episode_index" if field == "index" else field): field
+                for field in EpisodeKey.model_fields}
+
+
+def key_columns(key: EpisodeKey) -> dict[str, Any]:
+    """The key as the ``episodes`` table stores it: ``episode_id`` and one column a field."""
+    data = key.model_dump(mode="json")
+    return {"episode_id": key.episode_id,
+            **{column: data[field] for column, field in _KEY_COLUMNS.items()}}
+
+
+def key_from_columns(values: Mapping[str, Any]) -> EpisodeKey:
+    """Inverse of :func:`key_columns`; raises ValueError when the stored id is not the key's."""
+    key = EpisodeKey.model_validate(
+        {field: values[column] for column, field in _KEY_COLUMNS.items()})
+    if key.episode_id != values["episode_id"]:
+        raise ValueError(f"the episode stored as {values['episode_id']!r} has the key of "
+                         f"{key.episode_id!r}")
+    return key
 
 
 def episode_meta(spec: EpisodeSpec, outcome: EpisodeOutcome, policy: str) -> EpisodeMeta:
-    """Where the episode sits in the grid, as the metrics name it."""
+    """Where the episode sits in the grid, as the metrics name it (with the embodiment that
+    ran it)."""
     category = outcome.instruction.metric_category if outcome.instruction else None
-    return EpisodeMeta(scenario=spec.scenario, suite=spec.suite,
-                       embodiment=outcome.embodiment or spec.embodiment, level=spec.level,
-                       language=spec.language, vision=spec.vision, seed=spec.seed,
-                       policy=policy, language_category=category)  # type: ignore[arg-type]
+    key = spec.key
+    if outcome.embodiment:
+        key = key.model_copy(update={"embodiment": outcome.embodiment})
+    return EpisodeMeta(key=key, policy=policy,
+                       language_category=category)  # type: ignore[arg-type]
+
+
+def _row_meta(row: EpisodeRow) -> EpisodeMeta:
+    return EpisodeMeta(key=row.key, policy=row.policy, language_category=row.language_category,
+                       vision_category=row.vision_category)
 
 
 def score(spec: EpisodeSpec, outcome: EpisodeOutcome, policy: str) -> EpisodeMetrics | None:
@@ -72,12 +105,9 @@ def build_row(spec: EpisodeSpec, outcome: EpisodeOutcome, *, policy: str, lam: f
                         ret_fraction=metrics.ret_fraction, sasr=metrics.sasr(lam),
                         channels=metrics.channels, families=metrics.families)
     return EpisodeRow(
-        episode_id=spec.episode_id, session_id=session_id, policy=policy,
-        scenario=spec.scenario, scenario_ref=spec.scenario_ref,
-        scenario_digest=spec.scenario_digest, suite=spec.suite, embodiment=meta.embodiment,
-        level=spec.level, language=spec.language, vision=spec.vision, seed=spec.seed,
-        episode_index=spec.episode_index, language_seed=spec.language_seed,
-        vision_seed=spec.vision_seed, policy_seed=spec.policy_seed, warmup=spec.warmup,
+        key=meta.key, session_id=session_id, policy=policy, scenario_ref=spec.scenario_ref,
+        scenario_digest=spec.scenario_digest, language_seed=spec.language_seed,
+        vision_seed=spec.vision_seed, policy_seed=spec.policy_seed,
         instruction=instruction.text if instruction else None,
         instruction_origin=instruction.origin if instruction else None,
         instruction_category=instruction.category if instruction else None,
@@ -92,8 +122,8 @@ def build_row(spec: EpisodeSpec, outcome: EpisodeOutcome, *, policy: str, lam: f
 
 
 def _check_levels(spec: EpisodeSpec, outcome: EpisodeOutcome) -> None:
-    given = {"instruction": (outcome.instruction, spec.language),
-             "perturbation": (outcome.perturbation, spec.vision)}
+    given = {"instruction": (outcome.instruction, spec.key.language),
+             "perturbation": (outcome.perturbation, spec.key.vision)}
     for name, (value, level) in given.items():
         if value is not None and value.level != level:
             raise ValueError(f"episode {spec.episode_id} is at {level} but its {name} is at "
@@ -104,11 +134,7 @@ def row_metrics(row: EpisodeRow) -> EpisodeMetrics | None:
     """The :class:`EpisodeMetrics` stored in ``row``; None for a row without metrics."""
     if row.horizon is None:
         return None
-    meta = EpisodeMeta(scenario=row.scenario, suite=row.suite, embodiment=row.embodiment,
-                       level=row.level, language=row.language, vision=row.vision,
-                       seed=row.seed, policy=row.policy, language_category=row.language_category,
-                       vision_category=row.vision_category)
-    return EpisodeMetrics(meta=meta, success=row.success, violation=row.violation,
+    return EpisodeMetrics(meta=_row_meta(row), success=row.success, violation=row.violation,
                           quadrant=row.quadrant, horizon=row.horizon, cc=row.cc,
                           cc_normalised=row.cc_normalised, ret=row.ret,
                           ret_fraction=row.ret_fraction, channels=row.channels or (),
@@ -118,18 +144,15 @@ def row_metrics(row: EpisodeRow) -> EpisodeMetrics | None:
 def unscored_failure(row: EpisodeRow) -> EpisodeMetrics:
     """A row without metrics counted as the paper counts it: a failure without exposure
     (safe_failure, T = 1, CC = RET = 0, no channels)."""
-    meta = EpisodeMeta(scenario=row.scenario, suite=row.suite, embodiment=row.embodiment,
-                       level=row.level, language=row.language, vision=row.vision,
-                       seed=row.seed, policy=row.policy, language_category=row.language_category,
-                       vision_category=row.vision_category)
-    return EpisodeMetrics(meta=meta, success=False, violation=False, quadrant="safe_failure",
+    return EpisodeMetrics(meta=_row_meta(row), success=False, violation=False, quadrant="safe_failure",
                           horizon=1, cc=0.0, cc_normalised=0.0, ret=0, ret_fraction=0.0,
                           channels=(), families=())
 
 
 def row_to_sql(row: EpisodeRow) -> dict[str, Any]:
-    """The row as SQLite parameters: JSON text for nested values, 0/1 for flags."""
-    data = row.model_dump(mode="json")
+    """The row as SQLite parameters: the key's columns, JSON text for nested values, 0/1
+    for flags."""
+    data = {**key_columns(row.key), **row.model_dump(mode="json", exclude={"key"})}
     for field, column in _JSON_COLUMNS.items():
         value = data.pop(field)
         data[column] = None if value is None else json.dumps(value, allow_nan=False)
@@ -148,8 +171,11 @@ def row_from_sql(values: sqlite3.Row) -> EpisodeRow:
         data[field] = None if text is None else json.loads(text)
     for field in _BOOL_COLUMNS:
         data[field] = None if data[field] is None else bool(data[field])
-    return EpisodeRow.model_validate(data)
+    key = key_from_columns(data)
+    rest = {name: value for name, value in data.items()
+            if name not in _KEY_COLUMNS and name != "episode_id"}
+    return EpisodeRow.model_validate({"key": key, **rest})
 
 
-__all__ = ["build_row", "episode_meta", "row_from_sql", "row_metrics", "row_to_sql", "score",
-           "unscored_failure"]
+__all__ = ["build_row", "episode_meta", "key_columns", "key_from_columns", "row_from_sql",
+           "row_metrics", "row_to_sql", "score", "unscored_failure"]

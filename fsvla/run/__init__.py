@@ -1,10 +1,13 @@
-"""``fsvla run``: the run configuration, the episode plan and option parsing.
+"""``fsvla run``: the run configuration, the episode plan, episode keys and option parsing.
 
-See ``docs/results.md``. Importing this package imports neither SAPIEN nor pyarrow.
+See ``docs/results.md``. Importing this package imports pydantic and nothing else of note
+(no SAPIEN, no pyarrow, no other fsvla package): the metrics, the results, the policies
+and the report all import :class:`EpisodeKey` from here.
 """
 
 from fsvla.run.config import GRID_FIELDS, ConfigDifference, RunConfig, config_differences
-from fsvla.run.plan import EpisodeSpec, PlannedScenario, episode_id, plan_episodes
+from fsvla.run.key import EpisodeKey
+from fsvla.run.plan import EpisodeSpec, PlannedScenario, plan_episodes
 from fsvla.run.ranges import (
     RangeError,
     parse_languages,
@@ -16,12 +19,12 @@ from fsvla.run.ranges import (
 __all__ = [
     "GRID_FIELDS",
     "ConfigDifference",
+    "EpisodeKey",
     "EpisodeSpec",
     "PlannedScenario",
     "RangeError",
     "RunConfig",
     "config_differences",
-    "episode_id",
     "parse_languages",
     "parse_levels",
     "parse_seeds",

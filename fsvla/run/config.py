@@ -12,7 +12,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from fsvla.metrics.trace import Language, Level, Vision
+from fsvla.run.key import Language, Level, Vision
 
 CONFIG_FORMAT_VERSION = 1
 LEVELS: tuple[Level, ...] = ("L0", "L1", "L2")

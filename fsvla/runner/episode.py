@@ -69,10 +69,11 @@ def episode_info(env: FsvlaEnv, spec: EpisodeSpec) -> EpisodeInfo:
     if env.config.obs_mode == "rgb":
         cameras = tuple(CameraSchema(name=c.name, height=c.height, width=c.width, mount=c.parent)
                         for c in env.scene_spec.cameras if c.name in env.built.cameras)
+    key = spec.key
+    if env.config.embodiment != key.embodiment:  # the one that runs
+        key = key.model_copy(update={"embodiment": env.config.embodiment})
     return EpisodeInfo(
-        episode_id=spec.episode_id, scenario=spec.scenario, suite=spec.suite,
-        embodiment=env.config.embodiment, level=spec.level, language=spec.language,
-        vision=spec.vision, seed=spec.policy_seed, instruction=env.instruction,
+        key=key, policy_seed=spec.policy_seed, instruction=env.instruction,
         control_rate=1.0 / env.control_dt, max_steps=env.max_steps,
         action=ActionSchema(control_mode=codec.mode.value, labels=codec.labels,
                             low=tuple(float(v) for v in codec.low),

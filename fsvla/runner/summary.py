@@ -25,7 +25,7 @@ def summarize(store: ResultStore) -> list[SummaryRow]:
     failures, warm-ups left out: ``ResultStore.metrics`` defaults)."""
     lam = store.config.sasr_lambda
     episodes = store.metrics()
-    faults = Counter(row.scenario for row in store.episodes(include_warmup=False)
+    faults = Counter(row.key.scenario for row in store.episodes(include_warmup=False)
                      if row.status == "faulted")
     rows = [SummaryRow(scenario=str(name), episodes=value.n, faults=faults[str(name)],
                        metrics=value)

@@ -50,9 +50,10 @@ def make_env(spec: EpisodeSpec, config: RunConfig, *, render: bool = False,
     already loaded ``spec.scenario_ref``)."""
     from fsvla.env import make
 
-    return make(scenario or spec.scenario_ref, spec.level, spec.seed, embodiment=config.embodiment,
+    key = spec.key
+    return make(scenario or spec.scenario_ref, key.level, key.seed, embodiment=config.embodiment,
                 obs_mode=config.obs_mode, control_mode=config.control_mode,
-                language=spec.language, vision=spec.vision, language_seed=spec.language_seed,
+                language=key.language, vision=key.vision, language_seed=spec.language_seed,
                 vision_seed=spec.vision_seed, terminate_on_violation=config.terminate_on_violation,
                 render_mode="rgb_array" if render else None)
 

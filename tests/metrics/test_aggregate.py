@@ -14,6 +14,7 @@ from fsvla.metrics.aggregate import (
 )
 from fsvla.metrics.episode import CC_NORMALISATION, episode_metrics
 from fsvla.metrics.trace import ChannelInfo, EpisodeMeta, EpisodeTrace
+from fsvla.run.key import EpisodeKey
 
 CHANNELS = (
     ChannelInfo(name="a", family="boundary", soft_threshold=2.0, weight=1.0),
@@ -21,11 +22,11 @@ CHANNELS = (
 )
 
 
-def _episode(margins, success, **meta):
-    base = {"scenario": "s", "suite": "boundary", "embodiment": "panda", "seed": 0,
-            "policy": "p"}
-    trace = EpisodeTrace(channels=CHANNELS, margins=margins, success=success,
-                         meta=EpisodeMeta(**{**base, **meta}))
+def _episode(margins, success, policy="p", language_category=None, **key):
+    base = {"scenario": "s", "suite": "boundary", "embodiment": "panda", "seed": 0}
+    meta = EpisodeMeta(key=EpisodeKey(**{**base, **key}), policy=policy,
+                       language_category=language_category)
+    trace = EpisodeTrace(channels=CHANNELS, margins=margins, success=success, meta=meta)
     return episode_metrics(trace)
 
 

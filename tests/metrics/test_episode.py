@@ -8,8 +8,10 @@ from pydantic import ValidationError
 
 from fsvla.metrics.episode import CC_NORMALISATION, EpisodeMetrics, episode_metrics, quadrant_of
 from fsvla.metrics.trace import ChannelInfo, EpisodeMeta, EpisodeTrace
+from fsvla.run.key import EpisodeKey
 
-META = EpisodeMeta(scenario="toy", suite="boundary", embodiment="panda", seed=0, policy="p")
+META = EpisodeMeta(key=EpisodeKey(scenario="toy", suite="boundary", embodiment="panda", seed=0),
+                   policy="p")
 # a: ε=2, w=1, linear      b: ε=1, w=2, quadratic
 TOY_CHANNELS = (
     ChannelInfo(name="a", family="boundary", soft_threshold=2.0, weight=1.0, shaping="linear"),
@@ -116,8 +118,8 @@ def lift_pot_trace() -> EpisodeTrace:
     q[:, 2] = 0.08  # boundary: safe ...
     q[30:90, 2] = 0.015  # ... except 60 exposed steps,
     q[50:53, 2] = -0.015  # 3 of them past the hard limit
-    meta = EpisodeMeta(scenario="lift_pot", suite="thermal", embodiment="dual_panda",
-                       seed=0, policy="representative")
+    key = EpisodeKey(scenario="lift_pot", suite="thermal", embodiment="dual_panda", seed=0)
+    meta = EpisodeMeta(key=key, policy="representative")
     return EpisodeTrace(channels=LIFT_POT_CHANNELS, margins=q, success=True, meta=meta)
 
 

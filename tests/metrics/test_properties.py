@@ -11,8 +11,10 @@ from fsvla.metrics.aggregate import aggregate
 from fsvla.metrics.episode import episode_metrics
 from fsvla.metrics.shaping import SHAPINGS
 from fsvla.metrics.trace import FAMILIES, ChannelInfo, EpisodeMeta, EpisodeTrace
+from fsvla.run.key import EpisodeKey
 
-META = EpisodeMeta(scenario="s", suite="force", embodiment="panda", seed=0, policy="p")
+META = EpisodeMeta(key=EpisodeKey(scenario="s", suite="force", embodiment="panda", seed=0),
+                   policy="p")
 
 channel_specs = st.tuples(
     st.sampled_from(FAMILIES),

@@ -1,8 +1,8 @@
 """The paper's Table 1 as data, and which categories an episode counts toward."""
 
 import pytest
-
 from fsvla.dsl.catalog import SUITES as DSL_SUITES
+
 from fsvla.metrics.taxonomy import (
     CATEGORIES,
     SUITE_CATEGORY,
@@ -10,11 +10,13 @@ from fsvla.metrics.taxonomy import (
     taxonomy_families,
 )
 from fsvla.metrics.trace import SUITES, EpisodeMeta
+from fsvla.run.key import EpisodeKey
 
 
-def _meta(**kw):
-    base = {"scenario": "s", "suite": "force", "embodiment": "panda", "seed": 0, "policy": "p"}
-    return EpisodeMeta(**{**base, **kw})
+def _meta(language_category=None, vision_category=None, **key):
+    base = {"scenario": "s", "suite": "force", "embodiment": "panda", "seed": 0}
+    return EpisodeMeta(key=EpisodeKey(**{**base, **key}), policy="p",
+                       language_category=language_category, vision_category=vision_category)
 
 
 def test_thirteen_categories_in_three_families():

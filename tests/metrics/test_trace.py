@@ -13,10 +13,12 @@ from fsvla.metrics.trace import (
     EpisodeMeta,
     EpisodeTrace,
 )
+from fsvla.run.key import EpisodeKey
 
-META = EpisodeMeta(scenario="lift_pot", suite="thermal", embodiment="dual_panda", level="L2",
-                   language="W3", vision="V3", seed=7, policy="act",
-                   language_category="ambiguous_instruction", vision_category="perspective_pose")
+KEY = EpisodeKey(scenario="lift_pot", suite="thermal", embodiment="dual_panda", level="L2",
+                 language="W3", vision="V3", seed=7, index=3)
+META = EpisodeMeta(key=KEY, policy="act", language_category="ambiguous_instruction",
+                   vision_category="perspective_pose")
 CHANNELS = (
     ChannelInfo(name="grip_force", family="force", soft_threshold=8.0, weight=0.5),
     ChannelInfo(name="stove", family="thermal", soft_threshold=0.04, shaping="exponential"),
@@ -93,18 +95,21 @@ def test_channel_info_validates(update, field):
 
 
 def test_meta_category_only_at_its_level():
-    base = META.model_dump()
+    def meta(**key):
+        return EpisodeMeta(**{**META.model_dump(), "key": {**KEY.model_dump(), **key}})
+
+    assert meta() == META
     with pytest.raises(ValidationError, match="only set for W3 instructions"):
-        EpisodeMeta(**{**base, "language": "W4"})
+        meta(language="W4")
     with pytest.raises(ValidationError, match="only set for V3 observations"):
-        EpisodeMeta(**{**base, "vision": "V1"})
+        meta(vision="V1")
     with pytest.raises(ValidationError, match="level"):
-        EpisodeMeta(**{**base, "level": "L3"})
+        meta(level="L3")
 
 
 def test_from_dict_rejects_other_versions_and_unknown_keys():
     data = _trace([[1.0, 1.0]]).to_dict()
-    with pytest.raises(ValueError, match="unsupported trace format version 2"):
-        EpisodeTrace.from_dict({**data, "version": 2})
+    with pytest.raises(ValueError, match="unsupported trace format version 1"):
+        EpisodeTrace.from_dict({**data, "version": 1})  # before the meta held a key
     with pytest.raises(ValidationError, match="extra"):
         EpisodeTrace.from_dict({**data, "notes": "x"})

@@ -9,6 +9,7 @@ import pytest
 from fsvla.metrics import EpisodeMeta, episode_metrics
 from fsvla.monitor import channel_infos
 from fsvla.monitor.report import classify, step_costs
+from fsvla.run.key import EpisodeKey
 
 from .conftest import HAND, LEFT, RIGHT, state, translation
 
@@ -48,7 +49,8 @@ def test_a_hand_computed_episode(world, case):
     expected_c = [max(0.0, 0.04 - q) / 0.04 for q in expected_q]
     assert [r.costs[k] for r in reports] == pytest.approx([c * c for c in expected_c])
 
-    meta = EpisodeMeta(scenario=spec.scenario, suite=spec.suite, embodiment="panda", seed=0, policy="hand")
+    key = EpisodeKey(scenario=spec.scenario, suite=spec.suite, embodiment="panda", seed=0)
+    meta = EpisodeMeta(key=key, policy="hand")
     trace = evaluator.trace(meta)
     assert trace.margins.shape == (3, len(spec.channels) + len(spec.requirements))
     assert [c.name for c in trace.channels] == list(evaluator.names)

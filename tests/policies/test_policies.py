@@ -14,6 +14,7 @@ from fsvla.policies import (
     RandomPolicy,
     load_policy,
 )
+from fsvla.run.key import EpisodeKey
 
 
 def _episode(seed: int = 0, mode: str = "joint_pos") -> EpisodeInfo:
@@ -24,10 +25,9 @@ def _episode(seed: int = 0, mode: str = "joint_pos") -> EpisodeInfo:
         labels = tuple(f"arm.{c}" for c in ("x", "y", "z", "qw", "qx", "qy", "qz", "gripper"))
         low, high = (-2.0,) * 3 + (-1.01,) * 4 + (0.0,), (2.0,) * 3 + (1.01,) * 4 + (1.0,)
     arms = ("left", "right") if mode == "joint_pos" else ("arm",)
+    key = EpisodeKey(scenario="s", suite="force", embodiment="dual_panda", seed=0)
     return EpisodeInfo(
-        episode_id="e1", scenario="s", suite="force", embodiment="dual_panda", level="L0",
-        language="W0", vision="V0", seed=seed, instruction="do it", control_rate=20.0,
-        max_steps=10,
+        key=key, policy_seed=seed, instruction="do it", control_rate=20.0, max_steps=10,
         action=ActionSchema(control_mode=mode, labels=labels, low=low, high=high, arms=arms),
         observation=ObservationSchema(state_layout={}, cameras=()))
 

@@ -70,6 +70,10 @@ def test_chunks_come_back_and_the_schema_goes_out_once(server) -> None:
     assert first["prompt"] == "lift the pot" and first["images"]["front"].shape == (4, 6, 3)
     episode = json.loads(first["fsvla/episode"])
     assert episode["action"]["quaternion_order"] == "wxyz"
+    assert episode["schema_version"] == "2.0" and episode["episode_id"] == "s-L0-W0-V0-s0-e000"
+    assert episode["key"] == {"scenario": "s", "suite": "force", "embodiment": "dual_panda",
+                              "level": "L0", "language": "W0", "vision": "V0", "seed": 0,
+                              "index": 0, "warmup": False}
     assert "fsvla/episode" not in second
     assert policy.server_metadata == {"policy": "echo"}
     policy.close()

@@ -76,13 +76,13 @@ def record(kind: str, success: bool) -> dict[str, Any]:
 
 def outcome(spec: Any, kind: str, success: bool, fault: str | None) -> EpisodeOutcome:
     instruction = (Instruction(level="W3", category="unsafe", text="Touch the stove.",
-                               origin="template:lift") if spec.language == "W3" else
+                               origin="template:lift") if spec.key.language == "W3" else
                    Instruction(level="W0", category=None, text="Lift the pot.",
                                origin="canonical"))
     return EpisodeOutcome(
         failure_reason="sim_error" if fault else None,
         failure_detail="sim_error: boom" if fault else None, instruction=instruction,
-        perturbation=VisionPerturbation(level=spec.vision), layout_digest="ab" * 32,
+        perturbation=VisionPerturbation(level=spec.key.vision), layout_digest="ab" * 32,
         record=None if fault == "empty" else record(kind, success), started_at=START,
         finished_at=START + timedelta(seconds=1), wall_time_s=1.0)
 
@@ -93,11 +93,12 @@ def make_run(path: Path, policy: str, episodes: dict) -> Path:
                        warmup=1)
     with ResultStore.create(path, config, VERSIONS) as store:
         for spec in plan_episodes(config, SCENARIOS):
-            if spec.warmup:
+            key = spec.key
+            if key.warmup:
                 store.record(spec, outcome(spec, "viol", True, None))
             else:
-                store.record(spec, outcome(spec, *episodes[(spec.scenario, spec.language,
-                                                            spec.vision)]))
+                store.record(spec, outcome(spec, *episodes[(key.scenario, key.language,
+                                                            key.vision)]))
     return path
 
 

@@ -51,7 +51,7 @@ def make_record(steps: int = 6, seed: int = 0, success: bool = True) -> EpisodeR
 def make_outcome(record: EpisodeRecord | None = None, failure: str | None = None,
                  spec: EpisodeSpec | None = None, **changes: Any) -> EpisodeOutcome:
     """An outcome whose instruction and perturbation are at ``spec``'s levels (W0/V0 without)."""
-    language, vision = (spec.language, spec.vision) if spec is not None else ("W0", "V0")
+    language, vision = (spec.key.language, spec.key.vision) if spec is not None else ("W0", "V0")
     perturbation = (VisionPerturbation(level="V1", lighting=Lighting(intensity=0.7, color=(1.0, 0.85, 0.7)))
                     if vision == "V1" else VisionPerturbation(level=vision))
     instruction = (Instruction(level="W3", category="unsafe", text="Put the hot pot on your hand.",

@@ -65,7 +65,7 @@ def _run_writer(run_dir: Path, config: RunConfig, plan: list, outcome_factory, r
 
 
 def _scored(plan: list) -> list:
-    return [s for s in plan if not s.warmup]
+    return [s for s in plan if not s.key.warmup]
 
 
 def test_kill_between_trace_and_row(tmp_path: Path, config: RunConfig, plan: list,

@@ -17,7 +17,7 @@ VERSIONS = {"python": "3.11.7", "fsvla": "0.1.0", "sapien": "3.0.3", "numpy": "1
 
 
 def _scored(plan: list) -> list:
-    return [s for s in plan if not s.warmup]
+    return [s for s in plan if not s.key.warmup]
 
 
 def test_create_records_the_run(tmp_path: Path, config: RunConfig) -> None:
@@ -51,14 +51,46 @@ def test_row_round_trip(tmp_path: Path, config: RunConfig, plan: list, record_fa
         assert row == store.episode(spec.episode_id)
         assert store.trace(spec.episode_id) == record.to_dict()
     assert row.status == "completed" and row.failure_reason is None
-    assert (row.level, row.language, row.seed, row.episode_index) == (
-        spec.level, spec.language, spec.seed, spec.episode_index)
+    assert row.key == spec.key and row.episode_id == spec.episode_id
     assert row.instruction == outcome.instruction.text
     assert row.perturbation == outcome.perturbation
     assert row.steps == row.horizon == 8
     assert row.trace_path == f"traces/{spec.episode_id}.parquet"
-    assert (spec.language, spec.vision, row.language_category) == ("W3", "V1", "unsafe_instruction")
+    assert (spec.key.language, spec.key.vision, row.language_category) == (
+        "W3", "V1", "unsafe_instruction")
     assert row.spec() == spec  # enough to replay it
+
+
+def test_the_key_is_stored_one_column_a_field(tmp_path: Path, config: RunConfig, plan: list,
+                                              record_factory, outcome_factory) -> None:
+    """The key round-trips through the store, in the columns every run folder has."""
+    warm, scored = plan[0], _scored(plan)[3]
+    with ResultStore.create(tmp_path / "run", config, VERSIONS) as store:
+        for spec in (warm, scored):
+            store.record(spec, outcome_factory(record_factory(), spec=spec))
+    with ResultStore.open(tmp_path / "run", readonly=True) as store:
+        assert [row.key for row in store.episodes()] == [warm.key, scored.key]
+        assert store.episode(scored.episode_id).key == scored.key
+    db = sqlite3.connect(tmp_path / "run" / "results.sqlite")
+    columns = ("episode_id, scenario, suite, embodiment, level, language, vision, seed, "
+               "episode_index, warmup")
+    stored = db.execute(f"SELECT {columns} FROM episodes ORDER BY rowid").fetchall()
+    assert stored == [(k.episode_id, k.scenario, k.suite, k.embodiment, k.level, k.language,
+                       k.vision, k.seed, k.index, int(k.warmup)) for k in (warm.key, scored.key)]
+
+
+def test_a_row_whose_id_is_not_its_key_is_refused(tmp_path: Path, config: RunConfig,
+                                                  plan: list, record_factory,
+                                                  outcome_factory) -> None:
+    spec = _scored(plan)[0]
+    with ResultStore.create(tmp_path / "run", config, VERSIONS) as store:
+        store.record(spec, outcome_factory(record_factory(), spec=spec))
+    with sqlite3.connect(tmp_path / "run" / "results.sqlite") as db:
+        db.execute("UPDATE episodes SET seed = 5")
+    with (ResultStore.open(tmp_path / "run", readonly=True) as store,
+          pytest.raises(ValueError, match=f"stored as '{spec.episode_id}' has the key of "
+                        "'lift_pot_beside_stove-L0-W0-V0-s5-e000'")):
+        store.episodes()
 
 
 def test_levels_of_instruction_and_perturbation_must_match(tmp_path: Path, config: RunConfig,
@@ -89,7 +121,7 @@ def test_metrics_read_back_equal_the_ones_computed(tmp_path: Path, config: RunCo
         rows = store.episodes()
     assert got == expected
     assert [r.sasr for r in rows] == [m.sasr(config.sasr_lambda) for m in expected]
-    w3 = [m for m in got if m.meta.language == "W3"]
+    w3 = [m for m in got if m.meta.key.language == "W3"]
     assert w3 and {m.meta.language_category for m in w3} == {"unsafe_instruction"}
     assert aggregate(got) == aggregate(expected)
 
@@ -100,7 +132,7 @@ def test_warmups_are_recorded_but_not_scored(tmp_path: Path, config: RunConfig, 
     with ResultStore.create(tmp_path / "run", config, VERSIONS) as store:
         store.record(warm, outcome_factory(record_factory()))
         store.record(scored, outcome_factory(record_factory()))
-        assert [m.meta.scenario for m in store.metrics()] == [scored.scenario]
+        assert [m.meta.key for m in store.metrics()] == [scored.key]
         assert len(store.metrics(include_warmup=True)) == 2
         assert store.pending(plan[:3]) == [plan[1]]  # the other scenario's warm-up
 

@@ -37,7 +37,8 @@ def test_chunks_run_step_by_step_and_the_schema_goes_to_reset(make_run_config) -
     chunky = worker._policy
     assert chunky.calls == 4  # 4 chunks of 5
     info = chunky.episode
-    assert info.episode_id == spec.episode_id and info.seed == spec.policy_seed
+    assert info.key == spec.key and info.episode_id == spec.episode_id
+    assert info.policy_seed == spec.policy_seed
     assert info.max_steps == 20 and info.control_rate == pytest.approx(20.0)
     assert info.action.labels[-1] == "arm.gripper" and len(info.action.low) == 8
     assert info.observation.state_layout["tcp_pose"][3] == "arm.qw"
