@@ -34,12 +34,18 @@ y (its centre is off the support); two bodies (or a body and a zone's collision 
 e.g. a corridor's) on the same support whose axis-aligned footprint rectangles (after
 yaw, in the support's frame) overlap by more than 1 µm on both axes while their heights
 overlap too. Exact collision checks (FCL) belong to variant generation.
+
+Lowering runs in stages (support order, assets, object poses, footprints and overhangs,
+zones, overlaps, the embodiment); each returns its results with the problems it found
+and goes on, so one :class:`LoweringError` lists every problem of a layout (its
+``problems``, in the order they were written), each at its ``.fsv`` file, line and column.
 """
 
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -52,7 +58,7 @@ from fsvla.compiler.assets import (
     build_zone_marker,
 )
 from fsvla.compiler.assets.model import Shape
-from fsvla.dsl.models import Scenario, SourceRef, versioned_json_schema
+from fsvla.dsl.models import Placement, Scenario, SourceRef, versioned_json_schema
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from fsvla.embodiments import EmbodimentSpec, load_embodiment
@@ -244,17 +250,36 @@ def scene_json_schema_text() -> str:
     return json.dumps(scene_json_schema(), indent=2, sort_keys=True)
 
 
-class LoweringError(ValueError):
-    """A layout that cannot be lowered; ``source`` is where the offending thing was written."""
+@dataclass(frozen=True)
+class LoweringProblem:
+    """One reason a layout cannot be lowered, at the ``.fsv`` line of the offending thing."""
 
-    def __init__(self, message: str, source: SourceRef, *, hint: str | None = None):
+    message: str
+    source: SourceRef
+    hint: str | None = None
+
+    def __str__(self) -> str:
+        text = f"{self.source.file}:{self.source.line}:{self.source.column}: {self.message}"
+        return text + (f" (hint: {self.hint})" if self.hint else "")
+
+
+class LoweringError(ValueError):
+    """A layout that cannot be lowered. ``problems`` holds every problem found, in the order
+    they were written; ``message``, ``source`` and ``hint`` are the first one's."""
+
+    def __init__(self, message: str, source: SourceRef, *, hint: str | None = None,
+                 problems: Sequence[LoweringProblem] = ()):
         self.message = message
         self.source = source
         self.hint = hint
-        text = f"{source.file}:{source.line}:{source.column}: {message}"
-        if hint:
-            text += f" (hint: {hint})"
-        super().__init__(text)
+        self.problems = tuple(problems) or (LoweringProblem(message, source, hint),)
+        super().__init__("\n".join(str(problem) for problem in self.problems))
+
+    @classmethod
+    def of(cls, problems: Sequence[LoweringProblem]) -> LoweringError:
+        ordered = sorted(problems, key=lambda p: (p.source.file, p.source.line, p.source.column))
+        first = ordered[0]
+        return cls(first.message, first.source, hint=first.hint, problems=ordered)
 
 
 # --- lowering -----------------------------------------------------------------------------
@@ -322,10 +347,12 @@ def overhang_axis(rect: Rect, top: Rect) -> int | None:
 class _Footprint:
     """A thing on a support, for the overlap check (support frame)."""
 
-    __slots__ = ("name", "rect", "source", "what", "z")
+    __slots__ = ("name", "rect", "source", "support", "what", "z")
 
-    def __init__(self, name: str, what: str, rect: Rect, z: tuple[float, float], source: SourceRef):
+    def __init__(self, name: str, what: str, rect: Rect, z: tuple[float, float], source: SourceRef,
+                 support: str):
         self.name, self.what, self.rect, self.z, self.source = name, what, rect, z, source
+        self.support = support
 
 
 def lower_scene(
@@ -347,148 +374,25 @@ def lower_scene(
     ``allowed_roots`` bound file assets (see ``build_asset``). ``embodiment`` overrides
     loading ``scenario.embodiment`` by name. ``asset_builder``/``marker_builder`` (same
     signatures as ``build_asset``/``build_zone_marker``) let a caller that lowers many
-    layouts of one scenario reuse built assets. Raises :class:`LoweringError`."""
-    objects = {o.name: o for o in scenario.objects}
-    zone_names = {z.name for z in scenario.zones}
+    layouts of one scenario reuse built assets.
 
-    for obj in scenario.objects:
-        sup = obj.placement.support
-        if sup != WORLD and sup not in objects:
-            hint = "zones are not surfaces" if sup in zone_names else None
-            raise LoweringError(f"object {obj.name!r} stands on {sup!r}, which is not an object",
-                                obj.source, hint=hint)
-        if sup == obj.name:
-            raise LoweringError(f"object {obj.name!r} stands on itself", obj.source)
-    try:
-        order = support_order({o.name: o.placement.support for o in scenario.objects}, (WORLD,))
-    except CycleError as err:
-        raise LoweringError(f"objects support each other in a cycle: {' -> '.join(err.cycle)}",
-                            objects[err.cycle[0]].source) from None
-
-    # Build every asset first.
-    assets: dict[str, RigidAsset | ArticulatedAsset] = {}
-    for obj in scenario.objects:
-        folder = base_dir if base_dir is not None else Path(obj.source.file).parent
-        try:
-            assets[obj.name] = asset_builder(obj.asset, obj.params, base_dir=folder,
-                                             allowed_roots=allowed_roots)
-        except (ValueError, OSError) as err:
-            raise LoweringError(f"object {obj.name!r}: cannot build asset {obj.asset!r}: {err}",
-                                obj.source) from err
-
-    # The floor: the table stands on it, its top is z = 0.
-    table = objects.get("table")
-    ground_z = 0.0
-    if table is not None and table.placement.support == WORLD:
-        ground_z = -(surface_height(assets["table"]) + table.placement.height)
-    world = _Frame((0.0, 0.0), 0.0, ground_z, None)
-
-    frames: dict[str, _Frame] = {WORLD: world}
-    poses: dict[str, Pose] = {}
-    yaws: dict[str, float] = {}
-    for name in order:
-        obj = objects[name]
-        asset = assets[name]
-        support = frames[obj.placement.support]
-        pose, world_yaw = _place(support, obj.placement.position, obj.placement.height,
-                                 obj.placement.yaw)
-        poses[name], yaws[name] = pose, world_yaw
-        frames[name] = _Frame((pose.position[0], pose.position[1]), world_yaw,
-                              pose.position[2] + surface_height(asset), _rect_of(asset))
-
-    # Overhang: a footprint whose centre leaves its support's top.
-    on_support: dict[str, list[_Footprint]] = {}
-    for obj in scenario.objects:
-        asset = assets[obj.name]
-        p = obj.placement
-        rect = placed_rect(asset.footprint.min_xy, asset.footprint.max_xy, p.position, p.yaw)
-        z0 = poses[obj.name].position[2] + asset.bounds.center[2] - asset.bounds.half_extents[2]
-        z1 = poses[obj.name].position[2] + asset.bounds.center[2] + asset.bounds.half_extents[2]
-        on_support.setdefault(p.support, []).append(
-            _Footprint(obj.name, "object", rect, (z0, z1), obj.source))
-        top = frames[p.support].top
-        if top is None:
-            continue
-        axis = overhang_axis(rect, top)
-        if axis is not None:
-            amount, size = rect.overhang(top)[axis], rect.size[axis]
-            raise LoweringError(
-                f"object {obj.name!r} overhangs the top of {p.support!r} by {amount:.4f} m "
-                f"along {'xy'[axis]}, more than half its size ({size:.4f} m): its footprint "
-                f"{rect} vs the top {top} (in {p.support!r}'s frame)",
-                obj.source, hint="move it onto the support or make the support larger")
-
-    # Zones.
-    zones: list[SceneZone] = []
-    for zone in scenario.zones:
-        p = zone.placement
-        if p.support != WORLD and p.support not in objects:
-            raise LoweringError(f"zone {zone.name!r} lies on {p.support!r}, which is not an object",
-                                zone.source)
-        support_size = None
-        if p.support in assets:
-            support_size = frames[p.support].top.size  # type: ignore[union-attr]
-        try:
-            marker = marker_builder(zone.kind, zone.params, support_size=support_size)
-        except ValueError as err:
-            raise LoweringError(f"zone {zone.name!r}: cannot build {zone.kind!r}: {err}",
-                                zone.source) from err
-        pose, world_yaw = _place(frames[p.support], p.position, p.height, p.yaw)
-        region_box = _shape_box(marker.region)
-        if region_box is None:
-            b = marker.bounds
-            region_box = (tuple(c - h for c, h in zip(b.center, b.half_extents)),
-                          tuple(c + h for c, h in zip(b.center, b.half_extents)))
-        lo, hi = aabb(transform_points(box_corners(
-            tuple((a + b) / 2 for a, b in zip(*region_box)),
-            tuple((b - a) / 2 for a, b in zip(*region_box))), pose.position, pose.quaternion))
-        zones.append(SceneZone(name=zone.name, kind=zone.kind, marker=marker, pose=pose,
-                               region=marker.region, region_bounds=Box3(min=lo, max=hi),
-                               support=p.support, source=zone.source))
-        # A zone's collision walls (corridor) are static bodies on the support.
-        for i, wall in enumerate(marker.collision):
-            box = _shape_box(wall)
-            if box is None:
-                continue
-            rect = placed_rect(box[0][:2], box[1][:2], p.position, p.yaw)
-            z = (pose.position[2] + box[0][2], pose.position[2] + box[1][2])
-            on_support.setdefault(p.support, []).append(
-                _Footprint(zone.name, f"wall {wall.name or i}", rect, z, zone.source))
-
-    # Overlaps among the things on one support.
-    for support, items in on_support.items():
-        for i, a in enumerate(items):
-            for b in items[i + 1:]:
-                if a.name == b.name:
-                    continue
-                if min(a.z[1], b.z[1]) - max(a.z[0], b.z[0]) <= OVERLAP_TOLERANCE:
-                    continue
-                if a.rect.overlaps(b.rect):
-                    ox, oy = a.rect.overlap(b.rect)
-                    later = b  # report the one written second, naming the first
-                    what_a = f"{a.what} {a.name!r}" if a.what == "object" else f"{a.name!r} ({a.what})"
-                    what_b = f"{b.what} {b.name!r}" if b.what == "object" else f"{b.name!r} ({b.what})"
-                    raise LoweringError(
-                        f"{what_b} overlaps {what_a} on {support!r} by {ox:.4f} m x {oy:.4f} m: "
-                        f"footprints {b.rect} and {a.rect} (in {support!r}'s frame; "
-                        f"written at {a.source.file}:{a.source.line}:{a.source.column})",
-                        later.source, hint="move one of them apart")
-
-    bodies = tuple(
-        SceneBody(
-            name=obj.name,
-            asset=assets[obj.name],
-            pose=poses[obj.name],
-            is_static=(assets[obj.name].is_static if isinstance(assets[obj.name], RigidAsset)
-                       else assets[obj.name].fixed_base),  # type: ignore[union-attr]
-            hazard_role=obj.hazard_role,
-            support=obj.placement.support,
-            source=obj.source,
-        )
-        for obj in scenario.objects
-    )
-
-    spec = embodiment if embodiment is not None else _load_embodiment(scenario)
+    Each stage returns what it lowered and the problems it found, and goes on past a
+    problem; a thing that depends on one that failed (an object on a support that could
+    not be placed) is skipped, not reported again. Raises one :class:`LoweringError`
+    holding every problem."""
+    order, problems = _support_order(scenario)
+    assets, found = _build_assets(scenario, base_dir, allowed_roots, asset_builder)
+    problems += found
+    placed = _place_objects(scenario, order, assets)
+    footprints, found = _footprints(scenario, assets, placed)
+    problems += found
+    zones, walls, found = _lower_zones(scenario, assets, placed, marker_builder)
+    problems += found
+    problems += _overlaps(footprints + walls)
+    spec, found = _embodiment(scenario, embodiment)
+    problems += found
+    if problems:
+        raise LoweringError.of(problems)
     mounts = tuple(
         RobotMount(robot=r.name,
                    pose=Pose(position=tuple(r.mount.position), quaternion=yaw_quaternion(r.mount.yaw)),
@@ -508,9 +412,9 @@ def lower_scene(
         source_digest=scenario.source_digest,
         level=level,
         seed=seed,
-        ground_z=ground_z,
-        bodies=bodies,
-        zones=tuple(zones),
+        ground_z=placed.ground_z,
+        bodies=_bodies(scenario, assets, placed),
+        zones=zones,
         embodiment=spec,
         mounts=mounts,
         cameras=cameras,
@@ -518,17 +422,229 @@ def lower_scene(
     )
 
 
-def _load_embodiment(scenario: Scenario) -> EmbodimentSpec:
+# --- stages: each returns its results and the problems it found ---------------------------------
+
+
+def _support_order(scenario: Scenario) -> tuple[list[str], list[LoweringProblem]]:
+    """Objects in an order where every support comes before what stands on it. An object on
+    a missing support, on itself or in a support cycle is reported and left out."""
+    objects = {o.name: o for o in scenario.objects}
+    zone_names = {z.name for z in scenario.zones}
+    problems: list[LoweringProblem] = []
+    supports: dict[str, str] = {}
+    for obj in scenario.objects:
+        sup = obj.placement.support
+        if sup != WORLD and sup not in objects:
+            hint = "zones are not surfaces" if sup in zone_names else None
+            problems.append(LoweringProblem(f"object {obj.name!r} stands on {sup!r}, which is not an object",
+                                            obj.source, hint))
+        elif sup == obj.name:
+            problems.append(LoweringProblem(f"object {obj.name!r} stands on itself", obj.source))
+        else:
+            supports[obj.name] = sup
+    while True:
+        try:
+            return support_order(supports, (WORLD,)), problems
+        except CycleError as err:
+            problems.append(LoweringProblem(f"objects support each other in a cycle: {' -> '.join(err.cycle)}",
+                                            objects[err.cycle[0]].source))
+            for name in err.cycle:
+                supports.pop(name, None)
+
+
+def _build_assets(scenario: Scenario, base_dir: Path | None, allowed_roots: Sequence[Path],
+                  asset_builder: Callable[..., RigidAsset | ArticulatedAsset],
+                  ) -> tuple[dict[str, RigidAsset | ArticulatedAsset], list[LoweringProblem]]:
+    """Every object's asset; one that cannot be built is reported and left out."""
+    assets: dict[str, RigidAsset | ArticulatedAsset] = {}
+    problems: list[LoweringProblem] = []
+    for obj in scenario.objects:
+        folder = base_dir if base_dir is not None else Path(obj.source.file).parent
+        try:
+            assets[obj.name] = asset_builder(obj.asset, obj.params, base_dir=folder,
+                                             allowed_roots=allowed_roots)
+        except (ValueError, OSError) as err:
+            problems.append(LoweringProblem(f"object {obj.name!r}: cannot build asset {obj.asset!r}: {err}",
+                                            obj.source))
+    return assets, problems
+
+
+class _Placed:
+    """The objects placed so far: their world poses and the frames of their tops."""
+
+    __slots__ = ("frames", "ground_z", "poses")
+
+    def __init__(self, ground_z: float):
+        self.ground_z = ground_z
+        self.frames: dict[str, _Frame] = {WORLD: _Frame((0.0, 0.0), 0.0, ground_z, None)}
+        self.poses: dict[str, Pose] = {}
+
+
+def _place_objects(scenario: Scenario, order: Sequence[str],
+                   assets: Mapping[str, RigidAsset | ArticulatedAsset]) -> _Placed:
+    """World poses in support order, from the floor (the table stands on it, its top is z = 0).
+    An object without an asset, or on a support that was not placed, stays unplaced."""
+    objects = {o.name: o for o in scenario.objects}
+    table = objects.get("table")
+    ground_z = 0.0
+    if table is not None and table.placement.support == WORLD and "table" in assets:
+        ground_z = -(surface_height(assets["table"]) + table.placement.height)
+    placed = _Placed(ground_z)
+    for name in order:
+        obj = objects[name]
+        support = placed.frames.get(obj.placement.support)
+        if name not in assets or support is None:
+            continue
+        pose, world_yaw = _place(support, obj.placement.position, obj.placement.height,
+                                 obj.placement.yaw)
+        placed.poses[name] = pose
+        placed.frames[name] = _Frame((pose.position[0], pose.position[1]), world_yaw,
+                                     pose.position[2] + surface_height(assets[name]), _rect_of(assets[name]))
+    return placed
+
+
+def _footprints(scenario: Scenario, assets: Mapping[str, RigidAsset | ArticulatedAsset],
+                placed: _Placed) -> tuple[list[_Footprint], list[LoweringProblem]]:
+    """The footprint of every placed object, and each one whose centre leaves its support's top."""
+    footprints: list[_Footprint] = []
+    problems: list[LoweringProblem] = []
+    for obj in scenario.objects:
+        if obj.name not in placed.poses:
+            continue
+        asset, p = assets[obj.name], obj.placement
+        rect = placed_rect(asset.footprint.min_xy, asset.footprint.max_xy, p.position, p.yaw)
+        middle = placed.poses[obj.name].position[2] + asset.bounds.center[2]
+        z = (middle - asset.bounds.half_extents[2], middle + asset.bounds.half_extents[2])
+        footprints.append(_Footprint(obj.name, "object", rect, z, obj.source, p.support))
+        top = placed.frames[p.support].top
+        axis = overhang_axis(rect, top) if top is not None else None
+        if axis is not None:
+            amount, size = rect.overhang(top)[axis], rect.size[axis]
+            problems.append(LoweringProblem(
+                f"object {obj.name!r} overhangs the top of {p.support!r} by {amount:.4f} m "
+                f"along {'xy'[axis]}, more than half its size ({size:.4f} m): its footprint "
+                f"{rect} vs the top {top} (in {p.support!r}'s frame)",
+                obj.source, "move it onto the support or make the support larger"))
+    return footprints, problems
+
+
+def _lower_zones(scenario: Scenario, assets: Mapping[str, RigidAsset | ArticulatedAsset], placed: _Placed,
+                 marker_builder: Callable[..., ZoneAsset],
+                 ) -> tuple[tuple[SceneZone, ...], list[_Footprint], list[LoweringProblem]]:
+    """Every zone on a placed support, and the footprints of its collision walls (a corridor's)."""
+    zones: list[SceneZone] = []
+    walls: list[_Footprint] = []
+    problems: list[LoweringProblem] = []
+    objects = {o.name for o in scenario.objects}
+    for zone in scenario.zones:
+        p = zone.placement
+        if p.support != WORLD and p.support not in objects:
+            problems.append(LoweringProblem(f"zone {zone.name!r} lies on {p.support!r}, which is not an object",
+                                            zone.source))
+            continue
+        frame = placed.frames.get(p.support)
+        if frame is None:
+            continue  # its support could not be placed, which is reported already
+        support_size = frame.top.size if p.support in assets else None  # type: ignore[union-attr]
+        try:
+            marker = marker_builder(zone.kind, zone.params, support_size=support_size)
+        except ValueError as err:
+            problems.append(LoweringProblem(f"zone {zone.name!r}: cannot build {zone.kind!r}: {err}",
+                                            zone.source))
+            continue
+        pose, _ = _place(frame, p.position, p.height, p.yaw)
+        zones.append(SceneZone(name=zone.name, kind=zone.kind, marker=marker, pose=pose,
+                               region=marker.region, region_bounds=_region_bounds(marker, pose),
+                               support=p.support, source=zone.source))
+        walls += _walls(zone.name, marker, pose, p, zone.source)
+    return tuple(zones), walls, problems
+
+
+def _region_bounds(marker: ZoneAsset, pose: Pose) -> Box3:
+    """The world axis-aligned bound of a zone's monitored region."""
+    region_box = _shape_box(marker.region)
+    if region_box is None:
+        b = marker.bounds
+        region_box = (tuple(c - h for c, h in zip(b.center, b.half_extents)),
+                      tuple(c + h for c, h in zip(b.center, b.half_extents)))
+    lo, hi = aabb(transform_points(box_corners(
+        tuple((a + b) / 2 for a, b in zip(*region_box)),
+        tuple((b - a) / 2 for a, b in zip(*region_box))), pose.position, pose.quaternion))
+    return Box3(min=lo, max=hi)
+
+
+def _walls(name: str, marker: ZoneAsset, pose: Pose, p: Placement, source: SourceRef) -> list[_Footprint]:
+    """A zone's collision walls (a corridor's), static bodies on its support."""
+    walls = []
+    for i, wall in enumerate(marker.collision):
+        box = _shape_box(wall)
+        if box is None:
+            continue
+        rect = placed_rect(box[0][:2], box[1][:2], p.position, p.yaw)
+        z = (pose.position[2] + box[0][2], pose.position[2] + box[1][2])
+        walls.append(_Footprint(name, f"wall {wall.name or i}", rect, z, source, p.support))
+    return walls
+
+
+def _overlaps(footprints: Sequence[_Footprint]) -> list[LoweringProblem]:
+    """Every pair of things on one support whose footprints and heights overlap, reported at
+    the one written second."""
+    on_support: dict[str, list[_Footprint]] = {}
+    for footprint in footprints:
+        on_support.setdefault(footprint.support, []).append(footprint)
+    problems = []
+    for support, items in on_support.items():
+        for i, a in enumerate(items):
+            for b in items[i + 1:]:
+                if a.name == b.name or min(a.z[1], b.z[1]) - max(a.z[0], b.z[0]) <= OVERLAP_TOLERANCE:
+                    continue
+                if a.rect.overlaps(b.rect):
+                    problems.append(_overlap(support, a, b))
+    return problems
+
+
+def _overlap(support: str, a: _Footprint, b: _Footprint) -> LoweringProblem:
+    ox, oy = a.rect.overlap(b.rect)
+    what_a = f"{a.what} {a.name!r}" if a.what == "object" else f"{a.name!r} ({a.what})"
+    what_b = f"{b.what} {b.name!r}" if b.what == "object" else f"{b.name!r} ({b.what})"
+    return LoweringProblem(
+        f"{what_b} overlaps {what_a} on {support!r} by {ox:.4f} m x {oy:.4f} m: "
+        f"footprints {b.rect} and {a.rect} (in {support!r}'s frame; "
+        f"written at {a.source.file}:{a.source.line}:{a.source.column})",
+        b.source, "move one of them apart")
+
+
+def _embodiment(scenario: Scenario, given: EmbodimentSpec | None,
+                ) -> tuple[EmbodimentSpec | None, list[LoweringProblem]]:
+    if given is not None:
+        return given, []
     try:
-        return load_embodiment(scenario.embodiment)
-    except Exception as err:  # unknown name, bad file: point at the scenario
-        raise LoweringError(f"cannot load embodiment {scenario.embodiment!r}: {err}",
-                            scenario.source) from err
+        return load_embodiment(scenario.embodiment), []
+    except (KeyError, OSError, ValueError) as err:  # unknown name, bad file: point at the scenario
+        return None, [LoweringProblem(f"cannot load embodiment {scenario.embodiment!r}: {err}",
+                                      scenario.source)]
+
+
+def _bodies(scenario: Scenario, assets: Mapping[str, RigidAsset | ArticulatedAsset],
+            placed: _Placed) -> tuple[SceneBody, ...]:
+    return tuple(
+        SceneBody(
+            name=obj.name,
+            asset=assets[obj.name],
+            pose=placed.poses[obj.name],
+            is_static=(assets[obj.name].is_static if isinstance(assets[obj.name], RigidAsset)
+                       else assets[obj.name].fixed_base),  # type: ignore[union-attr]
+            hazard_role=obj.hazard_role,
+            support=obj.placement.support,
+            source=obj.source,
+        )
+        for obj in scenario.objects
+    )
 
 
 __all__ = [
     "DEFAULT_LIGHTS", "SCENE_SCHEMA_VERSION", "AmbientLight", "Box3", "DirectionalLight",
-    "Light", "LoweringError", "PhysicsSpec", "PointLight", "RobotMount", "SceneBody",
+    "Light", "LoweringError", "LoweringProblem", "PhysicsSpec", "PointLight", "RobotMount", "SceneBody",
     "SceneCamera", "SceneSpec", "SceneZone", "lower_scene", "overhang_axis", "scene_json_schema",
     "scene_json_schema_text", "surface_height",
 ]

@@ -117,9 +117,17 @@ def _report(results, output_format: str, quiet: bool = False) -> tuple[int, int]
 @_root_option
 @_format_option
 @click.option("--strict", is_flag=True, help="Treat warnings as errors.")
-def check(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str, strict: bool) -> None:
+@click.option("--deep", is_flag=True, help="Also run the static checks of `fsvla validate --static` "
+              "(reach, gripper opening, force limits against weights, hazards on targets); "
+              "loads the robots, so slower.")
+def check(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str, strict: bool,
+          deep: bool) -> None:
     """Check scenario files and folders and report every problem found."""
     results = _load_all(paths, roots)
+    if deep:
+        from .validate.static import deepen
+
+        deepen(results, list(roots) or default_roots(paths))
     errors, warnings = _report(results, output_format)
     sys.exit(1 if errors or (strict and warnings) else 0)
 
@@ -183,9 +191,9 @@ def parse_seeds(text: str) -> tuple[int, ...]:
 def _compile_scenes(results, levels: Sequence[str], seeds: Sequence[int],
                     roots: Sequence[Path]) -> dict[str, list[tuple[str, str]]]:
     """Each scenario's scene files (name, JSON). A scenario whose layouts cannot be generated
-    gets a diagnostic in its result instead, so that nothing of it is written."""
+    gets its diagnostics (every problem of its layout) instead, so that nothing of it is written."""
     from .compiler.scene import LoweringError
-    from .compiler.variants import generate_variant, lowering_diagnostic
+    from .compiler.variants import generate_variant, lowering_diagnostics
 
     scenes: dict[str, list[tuple[str, str]]] = {}
     for result in results:
@@ -197,7 +205,7 @@ def _compile_scenes(results, levels: Sequence[str], seeds: Sequence[int],
                  generate_variant(result.scenario, level, seed, allowed_roots=roots).scene.model_dump_json() + "\n")
                 for level in levels for seed in seeds]
         except LoweringError as error:
-            result.diagnostics.append(lowering_diagnostic(error, result.sources.get(error.source.file)))
+            result.diagnostics.extend(lowering_diagnostics(error, result.sources))
     return scenes
 
 
@@ -351,9 +359,14 @@ main.add_command(run_command)
 main.add_command(replay_command)
 
 # `fsvla collect`: demonstrations as a LeRobot dataset.
-from .collect.command import collect_command  # noqa: E402
+from .collect.command import collect_command
 
 main.add_command(collect_command)
+
+# `fsvla validate`: prove scenarios solvable, hazardous and safe at the start.
+from .validate.command import validate_command
+
+main.add_command(validate_command)
 
 
 def run(argv: Iterable[str] | None = None) -> int:

@@ -16,7 +16,7 @@ from pydantic import BaseModel, ConfigDict
 from fsvla.embodiments import EmbodimentSpec
 
 from ..scene import Level, SceneSpec, lower_scene
-from .errors import Infeasibility, VariantError, describe_rule, lowering_diagnostic
+from .errors import Infeasibility, VariantError, describe_rule, lowering_diagnostics
 from .feasibility import CLUTTER_CLEARANCE, CONTACT_TOLERANCE, REACH_MARGIN
 from .generate import (
     NEAR_DISTANCE,
@@ -76,5 +76,5 @@ def generate_variant(
 __all__ = [
     "CLUTTER_CLEARANCE", "CLUTTER_PALETTE", "CONTACT_TOLERANCE", "LEVELS", "NEAR_DISTANCE",
     "REACH_MARGIN", "Infeasibility", "Variant", "VariantError", "describe_rule", "generate_variant",
-    "lowering_diagnostic", "rules_of",
+    "lowering_diagnostics", "rules_of",
 ]

@@ -2,7 +2,8 @@
 
 Codes (documented in ``docs/variants.md``):
 
-- ``FSV600`` a layout that cannot be lowered at all (a plain ``LoweringError``);
+- ``FSV600`` a layout that cannot be lowered at all (one for each problem of a plain
+  ``LoweringError``);
 - ``FSV601`` a variant rule that can never hold (a static check, no sampling done);
 - ``FSV602`` no feasible layout within the sampling budget;
 - ``FSV603`` the canonical layout (L0, or a level that moves nothing) is infeasible.
@@ -76,12 +77,15 @@ class VariantError(LoweringError):
                           label=f.label, notes=f.notes, help=f"try: {remedies}" if remedies else None)
 
 
-def lowering_diagnostic(error: LoweringError, text: str | None = None) -> Diagnostic:
-    """Any lowering error as a diagnostic (FSV600, or the variant error's own code)."""
+def lowering_diagnostics(error: LoweringError, sources: Mapping[str, str]) -> list[Diagnostic]:
+    """Every problem of a lowering error as a diagnostic: FSV600 each, or the variant error's
+    own code. ``sources`` (file -> text) widens each caret to its statement."""
     if isinstance(error, VariantError):
-        return error.diagnostic(text)
-    return Diagnostic(code="FSV600", message=error.message, span=source_span(error.source, text),
-                      label="cannot be laid out", help=error.hint)
+        return [error.diagnostic(sources.get(error.source.file))]
+    return [Diagnostic(code="FSV600", message=problem.message,
+                       span=source_span(problem.source, sources.get(problem.source.file)),
+                       label="cannot be laid out", help=problem.hint)
+            for problem in error.problems]
 
 
 def source_span(source: SourceRef, text: str | None = None) -> Span:
@@ -134,5 +138,5 @@ def describe_rule(rule: VariantRule, scenario: Scenario | None = None) -> str:
     return f"couple {rule.requirement} within {rule.within:g} s"
 
 
-__all__ = ["REASONS", "Infeasibility", "VariantError", "cm", "describe_rule", "lowering_diagnostic",
+__all__ = ["REASONS", "Infeasibility", "VariantError", "cm", "describe_rule", "lowering_diagnostics",
            "quantity", "shares", "source_span"]

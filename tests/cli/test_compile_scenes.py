@@ -97,6 +97,26 @@ def test_a_failing_variant_renders_in_full_and_as_json(tmp_path: Path, capsys: p
     assert diagnostic["code"] == "FSV601" and diagnostic["span"]["line"] == 12
 
 
+def test_every_lowering_problem_is_a_diagnostic(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    source = tmp_path / "t.fsv"
+    source.write_text(
+        "scenario t\n  suite force\n  task pick_place(object=block, target=shelf)\n  embodiment panda\n"
+        '  instruction "Put the block on the shelf."\n'
+        "  object shelf: shelf(size=(40 cm, 25 cm), height=18 cm) at (15 cm, 25 cm)\n"
+        "  object block: block(size=(4 cm, 4 cm, 4 cm)) at (20 cm, 20 cm)\n"
+        "  object box: block(size=(4 cm, 4 cm, 4 cm)) at (21 cm, 0) on shelf\n"
+        "  constrain contact_force(gripper) <= 30 N warn 8 N\n"
+        "  success on(block, shelf) for 1 s\n", encoding="utf-8")
+    out = tmp_path / "out"
+    assert run(["compile", str(source), "-o", str(out), "--format", "json"]) == 1
+    diagnostics = json.loads(capsys.readouterr().out)
+    assert [(d["code"], d["span"]["line"], d["span"]["column"]) for d in diagnostics] == [
+        ("FSV600", 7, 10), ("FSV600", 8, 10)]
+    assert "overlaps object 'shelf'" in diagnostics[0]["message"]
+    assert "overhangs the top of 'shelf'" in diagnostics[1]["message"]
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("option", [["--levels", "L3"], ["--levels", ""], ["--seeds", "x"],
                                     ["--seeds", "4-2"], ["--seeds", "-1"]])
 def test_bad_levels_and_seeds_are_usage_errors(option: list[str], tmp_path: Path,

@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import pytest
+from fsvla.compiler.assets import build_asset
 from fsvla.compiler.placement import CycleError, Rect, placed_rect, support_order
 from fsvla.compiler.scene import (
     SCENE_SCHEMA_VERSION,
@@ -236,6 +237,74 @@ def test_overhang_names_the_line(tmp_path: Path) -> None:
     assert "overhang.fsv:8:" in str(err.value)
     # Sticking out by less than half its size is allowed (it still stands).
     lower_scene(_loads(text.replace("(21 cm, 0)", "(19 cm, 0)"), tmp_path))
+
+
+# --- every problem, each at its line ----------------------------------------------------------
+
+
+TWO_PROBLEMS = (
+    _header("two")
+    + "  object shelf: shelf(size=(40 cm, 25 cm), height=18 cm) at (15 cm, 25 cm)\n"
+    + "  object block: block(size=(4 cm, 4 cm, 4 cm)) at (20 cm, 20 cm)\n"
+    + "  object box: block(size=(4 cm, 4 cm, 4 cm)) at (21 cm, 0) on shelf\n"
+    + _footer()
+)
+
+
+def _failing(kind: str, error: Exception):
+    """``build_asset``, except that assets of ``kind`` raise ``error``."""
+
+    def builder(asset: str, params: dict, **kwargs):
+        if asset == kind:
+            raise error
+        return build_asset(asset, params, **kwargs)
+
+    return builder
+
+
+def test_two_independent_problems_are_both_reported(tmp_path: Path) -> None:
+    with pytest.raises(LoweringError) as err:
+        lower_scene(_loads(TWO_PROBLEMS, tmp_path, name="two.fsv"))
+    problems = err.value.problems
+    assert [(p.source.line, p.source.column) for p in problems] == [(8, 10), (9, 10)]
+    assert "'block' overlaps object 'shelf'" in problems[0].message
+    assert "'box' overhangs the top of 'shelf'" in problems[1].message
+    assert (err.value.message, err.value.source) == (problems[0].message, problems[0].source)
+    lines = str(err.value).splitlines()
+    assert len(lines) == 2 and lines[0].startswith("two.fsv:8:10: ") and lines[1].startswith("two.fsv:9:10: ")
+
+
+def test_problems_of_every_stage_are_collected(tmp_path: Path) -> None:
+    """A support that is a zone (support order), an asset that cannot be built (assets) and
+    an unknown embodiment, in one scenario: three problems, in the order they were written;
+    what stands on the broken object is skipped rather than reported again."""
+    scenario = _loads(ROTATED, tmp_path, name="stages.fsv")
+    block = scenario.object("block")
+    scenario = scenario.model_copy(update={
+        "embodiment": "no_such_robot",
+        "objects": tuple(o.model_copy(update={"placement": o.placement.model_copy(update={"support": "hot"})})
+                         if o.name == "block" else o for o in scenario.objects)})
+
+    with pytest.raises(LoweringError) as err:
+        lower_scene(scenario, asset_builder=_failing("shelf", ValueError("no shelf today")))
+    messages = [(p.source.line, p.message.split(":")[0]) for p in err.value.problems]
+    assert messages == [(1, "cannot load embodiment 'no_such_robot'"),
+                        (7, "object 'shelf'"),
+                        (block.source.line, "object 'block' stands on 'hot', which is not an object")]
+    assert err.value.problems[2].hint == "zones are not surfaces"
+
+
+def test_a_support_cycle_does_not_hide_other_problems(tmp_path: Path) -> None:
+    scenario = _loads(STACK, tmp_path)
+    shelf = scenario.object("shelf")
+    on_block = shelf.placement.model_copy(update={"support": "block"})
+    objects = tuple(o.model_copy(update={"placement": on_block}) if o.name == "shelf" else o
+                    for o in scenario.objects)
+    with pytest.raises(LoweringError) as err:
+        lower_scene(scenario.model_copy(update={"objects": objects}),
+                    asset_builder=_failing("table", OSError("gone")))
+    assert [p.message.split(":")[0] for p in err.value.problems] == [
+        "object 'table'", "objects support each other in a cycle"]
 
 
 # --- placement helpers --------------------------------------------------------------------------
