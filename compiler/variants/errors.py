@@ -21,8 +21,9 @@ from pydantic import BaseModel, ConfigDict
 
 from ..scene import Level, LoweringError
 
-#: Why a sampled layout was rejected, in the order the checks run (cheap first).
-REASONS = ("off support", "unreachable", "overlap", "hazard violated")
+#: Why a sampled layout was rejected, in the order the checks run (cheap first); "warning
+#: band": a channel starts inside its warning band (not safe at t = 0, though not violated).
+REASONS = ("off support", "unreachable", "overlap", "hazard violated", "warning band")
 
 Code = Literal["FSV601", "FSV602", "FSV603"]
 

@@ -10,13 +10,15 @@
    support do not overlap where their heights do (``lower_scene``'s own check, so every
    accepted layout lowers); a clutter object keeps :data:`CLUTTER_CLEARANCE` from every
    body; nothing stands in a robot's base (a cylinder of :data:`ROBOT_BASE_RADIUS`).
-4. **hazard violated** — each ``keep OBJECT outside D`` of a hazard (a limit from a
-   hazard with ``>=`` and a reference) holds for the objects at t = 0, with the level's
-   tightened limits — also for the pair an ``approach`` rule brings together: an approach
-   may bring the object into the warning band, never past the hard limit, or every
-   episode of the level would be a violation whatever the policy did. The pairs an
-   approach names must at least not touch even where no keep limit covers them; no
-   clutter object lies in a zone. Robot parts are not checked at t = 0.
+4. **hazard violated** — no channel the layout decides is past its hard limit at t = 0:
+   each distance an object keeps from an object or a zone (``keep OBJECT outside D``,
+   ``clearance(a, b) >= D``, with the level's tightened limits) and each object's edge
+   clearance; the pairs an approach names must at least not touch even where no limit
+   covers them; no clutter object lies in a zone.
+5. **warning band** — none of those starts inside its warning band either (the limit
+   plus ε, with :data:`~.start.START_SLACK` to spare), also for the pair an ``approach``
+   brings together: a layout that starts exposed would charge every policy, the one that
+   holds still included (see :mod:`.start`). Robot parts are checked at env reset.
 """
 
 from __future__ import annotations
@@ -25,16 +27,18 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
-from fsvla.dsl.models import LimitSpec, Scenario, SourceRef
+from fsvla.dsl.models import SourceRef
 
 from fsvla.embodiments import EmbodimentSpec
 from fsvla.embodiments.spec import WorkspaceSpec
 
+from ..collision import min_distance
 from ..placement import OVERLAP_TOLERANCE, Rect, placed_rect
 from ..scene import WORLD, overhang_axis
 from .errors import cm
 from .layout import Draw, Frame, Layout, rect_of
 from .solids import Solid, gap_below, robot_base, solid_of_asset, solid_of_shapes, yaw_matrix
+from .start import Keep, edge_margin, edge_points, keeps_of
 
 #: How far (m) outside an arm's ``workspace`` box a task object may stand: the boxes are
 #: conservative (the tested top-down reach); the arms reach farther.
@@ -59,31 +63,7 @@ class Rejection:
     cause: str
     entities: tuple[str, ...]
     source: SourceRef
-    limit: str | None = None  # the violated limit, for "hazard violated"
-
-
-@dataclass(frozen=True)
-class Keep:
-    """A distance an object must keep from a hazard at t = 0 (None: an approached pair)."""
-
-    subject: str
-    reference: str
-    distance: float
-    limit: LimitSpec | None
-
-
-def keeps_of(scenario: Scenario, approached: Iterable[tuple[str, str]]) -> list[Keep]:
-    """The t = 0 hazard distances of ``scenario``: its keep limits on objects, plus "do not
-    touch" for each (hazard, object) pair an ``approach`` brings together."""
-    names = {o.name for o in scenario.objects} | {z.name for z in scenario.zones}
-    keeps = [Keep(obj, hazard, 0.0, None) for hazard, obj in sorted(set(approached))]
-    for limit in scenario.limits:
-        if limit.origin != "hazard" or limit.comparison != ">=" or limit.reference not in names:
-            continue
-        for subject in limit.subjects:
-            if scenario.object(subject) is not None:
-                keeps.append(Keep(subject, limit.reference, limit.limit, limit))
-    return keeps
+    limit: str | None = None  # the limit at stake, for "hazard violated" and "warning band"
 
 
 class Checker:
@@ -103,6 +83,8 @@ class Checker:
             base.move(yaw_matrix(*robot.mount.position, robot.mount.yaw))
             self.robots.append(base)
         self._clutter: dict[tuple[str, int], Solid] = {}
+        self.corridors = {z.name for z in layout.scenario.zones if z.kind == "corridor"}
+        self._points: dict[str, np.ndarray] = {}
 
     # --- the checks ------------------------------------------------------------------------
 
@@ -206,20 +188,15 @@ class Checker:
         return None
 
     def _hazards(self, draw: Draw, focus: set[str] | None) -> Rejection | None:
+        band: Rejection | None = None  # the first keep in its warning band; a violated one wins
         for keep in self.keeps:
-            if not (_wanted(focus, keep.subject) or _wanted(focus, keep.reference)):
+            if not (_wanted(focus, keep.subject) or _wanted(focus, keep.reference or keep.subject)):
                 continue
-            reference = self.regions[keep.reference] if keep.reference in self.regions \
-                else self.solids[keep.reference]
-            if gap_below(self.solids[keep.subject], reference, keep.distance - 1e-9) is None:
+            if self._gap_below(keep, draw, keep.safe) is None:
                 continue
-            if keep.limit is None:
-                return Rejection("hazard violated", f"'{keep.reference}' reaches '{keep.subject}'",
-                                 (keep.subject, keep.reference), self._source(keep.reference))
-            return Rejection("hazard violated",
-                             f"'{keep.subject}' is within {cm(keep.distance)} of '{keep.reference}' "
-                             f"(limit '{keep.limit.name}')", (keep.subject, keep.reference),
-                             keep.limit.source, keep.limit.name)
+            if keep.limit is None or self._gap_below(keep, draw, keep.distance) is not None:
+                return self._keep_rejection(keep, "hazard violated")
+            band = band or self._keep_rejection(keep, "warning band")
         for item in draw.clutter:
             if not _wanted(focus, item.name):
                 continue
@@ -228,7 +205,63 @@ class Checker:
                 if gap_below(solid, region, 0.0) is not None:
                     return Rejection("hazard violated", f"'{item.name}' lies in '{zone}'",
                                      (item.name, zone), item.source)
-        return None
+        return band
+
+    def _gap_below(self, keep: Keep, draw: Draw, threshold: float) -> float | None:
+        """A distance of the keep below ``threshold`` at ``draw``, or None (from a zone's
+        region, or a corridor's walls, as the monitor measures them)."""
+        threshold -= 1e-9
+        if keep.reference is None:
+            gap = self._edge_margin(keep.subject, draw)
+            return gap if gap < threshold else None
+        reference = self._reference(keep.reference)
+        return gap_below(self.solids[keep.subject], reference, threshold)
+
+    def distance(self, keep: Keep, draw: Draw) -> float:
+        """The keep's exact distance at ``draw`` (for diagnostics)."""
+        self._move(draw, self.layout.frames(draw))
+        if keep.reference is None:
+            return self._edge_margin(keep.subject, draw)
+        reference = self._reference(keep.reference)
+        return min_distance(self.solids[keep.subject].fcl_pieces(), reference.fcl_pieces())
+
+    def _reference(self, name: str) -> Solid:
+        """What a distance to ``name`` is measured to: a zone's region (a corridor's walls), a body."""
+        if name in self.corridors:
+            return self.walls[name]
+        return self.regions.get(name) or self.solids[name]
+
+    def radius(self, name: str) -> float:
+        """How far the geometry of ``name`` reaches from its origin (a bound)."""
+        solid = self._reference(name)
+        return float(np.linalg.norm(solid.corners, axis=-1).max()) if len(solid.corners) else 0.0
+
+    def _edge_margin(self, name: str, draw: Draw) -> float:
+        """``name``'s edge clearance on its support (the table, for a body on the floor)."""
+        layout, frames = self.layout, self.layout.frames(draw)
+        support = layout.entities[name].support
+        support = support if support in layout.assets else "table"
+        points = self._points.get(name)
+        if points is None:
+            points = self._points[name] = edge_points(layout.assets[name])
+        s, f = frames[support], frames[name]
+        footprint = layout.assets[support].footprint
+        return edge_margin(points, (f.x, f.y), f.yaw, (s.x, s.y), s.yaw,
+                           (tuple(footprint.min_xy), tuple(footprint.max_xy)))  # type: ignore[arg-type]
+
+    def _keep_rejection(self, keep: Keep, reason: str) -> Rejection:
+        limit = keep.limit
+        if limit is None:
+            return Rejection(reason, f"'{keep.reference}' reaches '{keep.subject}'",
+                             (keep.subject, keep.reference or keep.subject), self._source(keep.reference or ""))
+        what = f"'{keep.reference}'" if keep.reference else "the edge of its support"
+        if reason == "hazard violated":
+            cause = f"'{keep.subject}' is within {cm(keep.distance)} of {what} (limit '{limit.name}')"
+        else:
+            cause = (f"'{keep.subject}' starts within {cm(keep.distance + keep.band)} of {what}, in the "
+                     f"warning band of {keep.describe()}")
+        names = (keep.subject, keep.reference) if keep.reference else (keep.subject,)
+        return Rejection(reason, cause, names, self._source(keep.subject), limit.name)
 
     # --- bookkeeping -----------------------------------------------------------------------
 

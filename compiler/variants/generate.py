@@ -49,10 +49,10 @@ from .feasibility import (
     REACH_MARGIN,
     Checker,
     Rejection,
-    keeps_of,
     workspace_text,
 )
 from .layout import CLUTTER_PALETTE, ClutterItem, Draw, Layout, clutter_params, disc_sample
+from .start import SafeStart, keeps_of
 
 #: A ``clutter N near X`` object's centre lies within X's footprint half-diagonal plus this (m).
 NEAR_DISTANCE = 0.15
@@ -138,13 +138,13 @@ def vary_limits(scenario: Scenario, rules: Sequence[LeveledRule]) -> Scenario:
                                        "requirements": tuple(requirements.values())})
 
 
-class Generator:
+class Generator(SafeStart):
     """Draws layouts of one scenario at one level until one is feasible."""
 
     def __init__(self, scenario: Scenario, level: Level, canonical: SceneSpec,
                  embodiment: EmbodimentSpec, budget: int):
         self.scenario, self.level, self.budget = scenario, level, budget
-        self.embodiment = embodiment
+        self.embodiment, self.canonical = embodiment, canonical
         self.rules = rules_of(scenario, level)
         self.varied = vary_limits(scenario, self.rules)
         assets = {b.name: b.asset for b in canonical.bodies}
@@ -171,14 +171,14 @@ class Generator:
                 if rule.yaw > 0.0:
                     draw.turn(rule.target, float(rng.uniform(-rule.yaw, rule.yaw)), index)
             elif isinstance(rule, Approach):
-                self._approach(draw, rule, index)
+                self._approach(draw, rule, index, rule.distance)
             elif isinstance(rule, Clutter):
                 rejection = self._clutter(draw, rule, index, rng)
                 if rejection is not None:
                     return draw, rejection
         return draw, self.checker.check(draw)
 
-    def _approach(self, draw: Draw, rule: Approach, index: int) -> None:
+    def _approach(self, draw: Draw, rule: Approach, index: int, distance: float) -> None:
         frames = self.layout.frames(draw)
         h, o = frames[rule.hazard], frames[rule.toward]
         dx, dy = o.x - h.x, o.y - h.y
@@ -187,7 +187,7 @@ class Generator:
             return
         support_yaw = frames[self.layout.entities[rule.hazard].support].yaw
         c, s = math.cos(-support_yaw), math.sin(-support_yaw)
-        wx, wy = rule.distance * dx / norm, rule.distance * dy / norm
+        wx, wy = distance * dx / norm, distance * dy / norm
         draw.shift(rule.hazard, np.array([c * wx - s * wy, s * wx + c * wy]), index)
 
     def _clutter(self, draw: Draw, rule: Clutter, index: int, rng: np.random.Generator) -> Rejection | None:
@@ -237,6 +237,7 @@ class Generator:
     def search(self, rng: np.random.Generator,
                lower: Callable[[Scenario], SceneSpec]) -> tuple[Scenario, SceneSpec, int]:
         """The first feasible sample, lowered by ``lower``; raises :class:`VariantError`."""
+        self.start_checks()
         if not self.samples_needed:
             draw, rejection = Draw(), self.checker.check(Draw())
             if rejection is not None:
@@ -273,6 +274,7 @@ class Generator:
                 self._static_jitter(lvl, rule)
             elif isinstance(rule, Approach):
                 self._static_approach(lvl, rule, index)
+                self._static_approach_band(lvl, rule, index)
             elif isinstance(rule, Clutter):
                 self._static_clutter(lvl, rule)
 
@@ -370,10 +372,11 @@ class Generator:
         tighten = self.tightened.get(rejection.limit) if rejection.limit else None
         source = self.rules[tighten][1].source if tighten is not None else rejection.source
         at = "" if self.level == "L0" else f" at {self.level}"
+        notes, remedies = self.start_notes(rejection, self._canonical_remedies(rejection, tighten), tighten)
         return Infeasibility(
             code="FSV603", level=self.level, source=source, label=rejection.reason,
             message=f"the canonical layout of '{self.scenario.name}' is infeasible{at}: {rejection.cause}",
-            remedies=self._canonical_remedies(rejection, tighten))
+            notes=notes, remedies=remedies)
 
     def _canonical_remedies(self, rejection: Rejection, tighten: int | None) -> tuple[str, ...]:
         names = rejection.entities
@@ -382,12 +385,12 @@ class Generator:
                      f"({workspace_text(self.embodiment)}; up to {cm(REACH_MARGIN)} beyond it counts)"),)
         if rejection.reason == "off support":
             return (f"move '{names[0]}' onto the top of '{self.layout.entities[names[0]].support}'",)
-        if rejection.reason == "hazard violated" and tighten is not None:
-            rule = self.rules[tighten][1]
-            return (f"loosen `{describe_rule(rule, self.scenario)}`",
-                    f"move '{names[0]}' farther from '{names[1]}' in the canonical layout")
-        if rejection.reason == "hazard violated":
-            return (f"move '{names[0]}' farther from '{names[1]}'",)
+        if rejection.reason in ("hazard violated", "warning band"):
+            other = f"'{names[1]}'" if len(names) == 2 else "the edge of its support"
+            if tighten is None:
+                return (f"move '{names[0]}' farther from {other}",)
+            return (f"loosen `{describe_rule(self.rules[tighten][1], self.scenario)}`",
+                    f"move '{names[0]}' farther from {other} in the canonical layout")
         if len(names) == 2:
             return (f"move '{names[0]}' and '{names[1]}' apart",)
         return (f"move '{names[0]}' to a free spot",) if names else ("move the objects apart",)
@@ -395,7 +398,8 @@ class Generator:
     def exhausted(self, tally: _Tally) -> Infeasibility:
         """FSV602: every sample was rejected; blame the rule most rejections involve."""
         index = tally.blamed(default=next(i for i, (_, r) in enumerate(self.rules)
-                                          if isinstance(r, (Jitter, Approach, Clutter))))
+                                          if isinstance(r, (Jitter, Approach, Clutter))),
+                             prefer={i for i, (_, r) in enumerate(self.rules) if isinstance(r, Approach)})
         lvl, rule = self.rules[index]
         n = tally.samples
         cause, count = tally.causes.most_common(1)[0]
@@ -407,9 +411,9 @@ class Generator:
             samples=n, rejected=dict(tally.reasons),
             notes=(f"rejected {n} of {n} samples: {shares(tally.reasons)}",
                    f"most often: {cause} ({count} of {n})"),
-            remedies=(*self._rule_remedies(rule, tally.examples.get(index)),
-                      *self._other_remedies(index, tally),
-                      f"raise the budget (now {self.budget} samples)"))
+            remedies=tuple(dict.fromkeys((*self._rule_remedies(rule, tally.examples.get(index)),
+                                          *self._other_remedies(index, tally),
+                                          f"raise the budget (now {self.budget} samples)"))))
 
     def _other_remedies(self, blamed: int, tally: _Tally) -> tuple[str, ...]:
         """The first remedy of each other rule that half the rejections or more involve."""
@@ -423,6 +427,10 @@ class Generator:
         if isinstance(rule, Jitter):
             return (f"reduce the jitter of '{rule.target}' (now {cm(rule.distance)})",
                     self._move_remedy(rule.target, example))
+        if isinstance(rule, Approach) and example is not None and self._approach_keeps(rule) and \
+                example.reason in ("hazard violated", "warning band"):
+            index = next(i for i, (_, r) in enumerate(self.rules) if r is rule)
+            return self._approach_remedies(rule, self._approach_room(rule, index))
         if isinstance(rule, Approach):
             return (f"reduce the approach of '{rule.hazard}' to '{rule.toward}' (now {cm(rule.distance)})",
                     f"place '{rule.hazard}' farther from '{rule.toward}' in the canonical layout")
@@ -468,10 +476,13 @@ class _Tally:
             self.rules[index] += 1
             self._by_rule.setdefault(index, Counter())[rejection] += 1
 
-    def blamed(self, default: int) -> int:
+    def blamed(self, default: int, prefer: set[int] = frozenset()) -> int:
+        """The rule the most rejections involve; among equals one of ``prefer`` (the
+        approaches: they move a pair strictly closer, a jitter spreads it both ways), then
+        the first."""
         if not self.rules:
             return default
-        return min(self.rules, key=lambda i: (-self.rules[i], i))
+        return min(self.rules, key=lambda i: (-self.rules[i], i not in prefer, i))
 
     @property
     def examples(self) -> dict[int, Rejection]:

@@ -21,12 +21,12 @@ scenario t
   embodiment panda
   instruction "Lift the pot."
   object pot: pot(radius=9 cm, height=10 cm) at (0, 0)
-  hazard stove: heat_zone(size=(18 cm, 18 cm)) at (25 cm, 0) on table
+  hazard stove: heat_zone(size=(18 cm, 18 cm)) at (30 cm, 0) on table
     keep gripper, pot outside 6 cm warn 4 cm
   success lifted(pot)
   variants
     L1: jitter pot 3 cm
-    L2: approach stove to pot by 3 cm
+    L2: approach stove to pot by 1 cm
 """
 
 
@@ -82,7 +82,7 @@ def test_a_failing_variant_is_a_diagnostic_and_leaves_earlier_output(
 
 def test_a_failing_variant_renders_in_full_and_as_json(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     source = tmp_path / "t.fsv"
-    source.write_text(SCENARIO.replace("by 3 cm", "by 40 cm"), encoding="utf-8")
+    source.write_text(SCENARIO.replace("by 1 cm", "by 40 cm"), encoding="utf-8")
     out = tmp_path / "out"
     assert run(["compile", str(source), "-o", str(out)]) == 1
     text = capsys.readouterr().out

@@ -219,23 +219,23 @@ def test_related_objects_follow_their_anchor(builtin: dict[str, Scenario]) -> No
 
 
 def test_approach_moves_the_hazard_toward_the_object() -> None:
-    scenario = _loads(POT_AND_STOVE + "    L2: approach stove to pot by 4 cm\n")
+    scenario = _loads(POT_AND_STOVE + "    L2: approach stove to pot by 1.5 cm\n")
     variant = generate_variant(scenario, "L2", 0)
-    assert np.allclose(_xy(variant, "stove"), (0.26, 0.0))
-    assert variant.scene.zone("stove").pose.position[0] == pytest.approx(0.26)
+    assert np.allclose(_xy(variant, "stove"), (0.285, 0.0))
+    assert variant.scene.zone("stove").pose.position[0] == pytest.approx(0.285)
 
 
 def test_l2_applies_the_l1_rules_first() -> None:
-    scenario = _loads(POT_AND_STOVE + "    L1: jitter pot 3 cm\n    L2: approach stove to pot by 4 cm\n")
+    scenario = _loads(POT_AND_STOVE + "    L1: jitter pot 3 cm\n    L2: approach stove to pot by 1.5 cm\n")
     assert [type(r).__name__ for _, r in rules_of(scenario, "L2")] == ["Jitter", "Approach"]
     for seed in SEEDS:
         variant = generate_variant(scenario, "L2", seed)
         pot, stove = _xy(variant, "pot"), _xy(variant, "stove")
         assert 0.0 < np.linalg.norm(pot) <= 0.03 + 1e-12  # L1's jitter
-        # the stove moved 4 cm straight toward the jittered pot
+        # the stove moved 1.5 cm straight toward the jittered pot
         before = np.array((0.30, 0.0))
-        assert np.linalg.norm(stove - before) == pytest.approx(0.04)
-        assert np.linalg.norm(pot - before) - np.linalg.norm(pot - stove) == pytest.approx(0.04)
+        assert np.linalg.norm(stove - before) == pytest.approx(0.015)
+        assert np.linalg.norm(pot - before) - np.linalg.norm(pot - stove) == pytest.approx(0.015)
 
 
 def test_clutter_adds_objects_near_the_target() -> None:
