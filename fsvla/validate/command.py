@@ -93,9 +93,8 @@ def _load(paths: tuple[Path, ...], roots: tuple[Path, ...],
           output_format: str) -> tuple[list[Any], dict[str, str]]:
     """The concrete scenarios under ``paths`` (abstract bases skipped); a file that does not
     check has its diagnostics printed and exits 2."""
-    from fsvla.dsl.loader import ScenarioLoader
-
     from fsvla.cli import collect_files
+    from fsvla.dsl.loader import ScenarioLoader
 
     from .output import show_diagnostics
     from .sources import Located

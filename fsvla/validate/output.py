@@ -8,10 +8,11 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import click
-from fsvla.dsl.diagnostics import Diagnostic
-from fsvla.dsl.render import render_concise, render_full, render_json
 from rich.console import Console
 from rich.table import Table
+
+from fsvla.dsl.diagnostics import Diagnostic
+from fsvla.dsl.render import render_concise, render_full, render_json
 
 from .verdicts import PROPERTIES, Verdict
 

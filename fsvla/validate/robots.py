@@ -26,9 +26,9 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
-from fsvla.compiler.pose import matrix_to_quat, point_axis, quat_to_matrix
 from numpy.typing import NDArray
 
+from fsvla.compiler.pose import matrix_to_quat, point_axis, quat_to_matrix
 from fsvla.embodiments.spec import EmbodimentSpec
 
 #: Approach directions tried, in degrees from straight down: positive tilts away from the

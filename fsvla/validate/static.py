@@ -32,6 +32,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
+
 from fsvla.compiler.assets.model import RigidAsset, Shape, SphereShape
 from fsvla.compiler.collision import min_distance, pieces_of, shape_vertices
 from fsvla.compiler.pose import pose_matrix
@@ -40,7 +42,6 @@ from fsvla.compiler.variants.errors import cm, quantity
 from fsvla.dsl.catalog import robot_parts
 from fsvla.dsl.diagnostics import Diagnostic, Related, Severity
 from fsvla.dsl.models import LimitSpec, Scenario
-from numpy.typing import NDArray
 
 from . import codes
 from .explain import channel_text

@@ -6,10 +6,10 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
-
 from fsvla.dsl.loader import ScenarioLoader
 from fsvla.dsl.models import Predicate
 from fsvla.dsl.render import render_concise
+
 from fsvla.metrics.episode import ChannelMetrics
 from fsvla.validate.conjuncts import ConjunctTrack, SuccessReplay, longest_run
 from fsvla.validate.explain import (
@@ -85,12 +85,12 @@ def test_crossed_limits_are_reported_on_their_lines_with_the_worst_value(located
                 channel("held", -1.0, family="temporal"))]
     found = violation_diagnostics(located, "L0", rows, code="FSV712", who="the careful expert")
     assert concise(found) == [
-        "mug_tray.fsv:13:3: FSV712 the careful expert crossed `grip` at L0: 24.5 N observed, "
-        "against `contact_force(gripper) <= 20 N`",
-        "mug_tray.fsv:11:5: FSV712 the careful expert crossed `stove` at L0: 3 cm observed, "
-        "against `keep gripper, mug outside 5 cm of stove`",
-        "mug_tray.fsv:14:3: FSV712 the careful expert broke the requirement `held` at L0: its "
-        "second condition began to hold before its first had held"]
+        ("mug_tray.fsv:13:3: FSV712 the careful expert crossed `grip` at L0: 24.5 N observed, "
+        "against `contact_force(gripper) <= 20 N`"),
+        ("mug_tray.fsv:11:5: FSV712 the careful expert crossed `stove` at L0: 3 cm observed, "
+        "against `keep gripper, mug outside 5 cm of stove`"),
+        ("mug_tray.fsv:14:3: FSV712 the careful expert broke the requirement `held` at L0: its "
+        "second condition began to hold before its first had held")]
     assert found[0].notes == ("crossed in 2 of 2 episodes; worst: e1, from step 40",)
     assert all(d.is_error for d in found)
     at_l2 = violation_diagnostics(located, "L2", rows[:1], code="FSV712", who="the careful expert")
@@ -103,8 +103,8 @@ def test_faults_are_reported_on_the_scenario_line(located: Located) -> None:
             row("e1", status="faulted", reason="sim_error", detail="again"), row("e2")]
     found = fault_diagnostics(located, "L1", rows, code="FSV713", who="the careful expert")
     assert concise(found) == [
-        "mug_tray.fsv:1:10: FSV713 2 episodes of the careful expert at L1 ended in a fault: "
-        "sim_error (replay it with `fsvla replay` to see where it fails)"]
+        ("mug_tray.fsv:1:10: FSV713 2 episodes of the careful expert at L1 ended in a fault: "
+        "sim_error (replay it with `fsvla replay` to see where it fails)")]
     assert found[0].notes == ("e0: layout infeasible",)
 
 
