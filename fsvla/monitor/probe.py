@@ -216,9 +216,6 @@ class Probe:
         """Whether substeps are read at all (free bodies or a scan filter)."""
         return bool(self._free) or bool(self._scan_reading.filter)
 
-    def frame_of(self, component: Any) -> str:
-        return self._frame_of.get(id(component)) or f"?{component.entity.name}"
-
     def reset(self) -> None:
         """Forget the maxima and re-read velocities (after the scene was reset)."""
         self.maxima.clear()
