@@ -148,7 +148,7 @@ def reach_findings(layout: Layout) -> list[Diagnostic]:
         x, y = (float(v) + 0.0 for v in body.pose.position[:2])
         who = embodiment_arm(scenario.embodiment, arm, len(gaps))
         need = " (a two-arm lift needs both arms)" if every_arm and len(gaps) > 1 else ""
-        base = model.base(arm) + 0.0  # no "-0 cm"
+        base = np.round(model.base(arm), 4) + 0.0  # no "-0 cm"
         found.append(Diagnostic(
             code=codes.REACH, severity=Severity.WARNING,
             message=f"{who} cannot reach `{name}` at ({cm(x)}, {cm(y)}): {cm(gap)} beyond "
