@@ -7,7 +7,6 @@ from pathlib import Path
 
 import pytest
 
-pytest.importorskip("sapien")
 pytest.importorskip("pyarrow")
 from fsvla.cli import run
 

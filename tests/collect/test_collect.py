@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("sapien")
 pytest.importorskip("pyarrow")
 import pyarrow.parquet as pq
 

@@ -15,12 +15,11 @@ import numpy as np
 import pytest
 
 from fsvla.embodiments import builtin_embodiments, load_embodiment
-
-sapien = pytest.importorskip("sapien")
-
 from fsvla.sim.kinematics import ArmKinematics
 from fsvla.sim.robot import LoadedRobot, load_robot, self_collision_bits, srdf_disabled_pairs
+from tests.conftest import require_sapien
 
+sapien = require_sapien()
 pytestmark = pytest.mark.sim
 
 HOLD_STEPS = 500

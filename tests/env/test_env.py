@@ -5,13 +5,12 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import gymnasium
 import numpy as np
 import pytest
 
-pytest.importorskip("sapien")
-import gymnasium  # noqa: E402
-from fsvla.env import FsvlaEnv, InvalidActionError, env_id, make  # noqa: E402
-from fsvla.policies.simple import hold_action  # noqa: E402
+from fsvla.env import FsvlaEnv, InvalidActionError, env_id, make
+from fsvla.policies.simple import hold_action
 
 pytestmark = pytest.mark.sim
 

@@ -16,8 +16,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("sapien")
-
 import fsvla
 from fsvla.library import builtin_scenarios
 from fsvla.monitor import SafetyMonitor

@@ -13,9 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-pytest.importorskip("sapien")
-
 from fsvla.compiler.collision import signed_distance
 
 import fsvla

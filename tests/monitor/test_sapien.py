@@ -7,9 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-sapien = pytest.importorskip("sapien")
-
 from fsvla.compiler.collision import min_distance, pieces_of
 from fsvla.compiler.monitor import lower_monitor
 from fsvla.compiler.scene import lower_scene
@@ -19,7 +16,9 @@ from fsvla.monitor import SafetyMonitor
 from fsvla.monitor.geometry import SceneGeometry, shapes_of_sapien
 from fsvla.monitor.probe import NET, ContactFilter, Probe
 from fsvla.monitor.state import pair_key
+from tests.conftest import require_sapien
 
+sapien = require_sapien()
 pytestmark = pytest.mark.sim
 REPO = Path(__file__).resolve().parents[2]
 DT = 0.002

@@ -8,8 +8,7 @@ from typing import Any
 
 import pytest
 
-pytest.importorskip("sapien")
-pytest.importorskip("pyarrow")
+pytest.importorskip("pyarrow")  # SAPIEN: every test here is marked sim
 
 from fsvla.run import RunConfig
 from fsvla.runner import execute_run, make_backend, make_config, prepare_run

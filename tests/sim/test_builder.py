@@ -14,11 +14,11 @@ import pytest
 from fsvla.compiler.assets.model import CylinderShape, Material, Pose
 from fsvla.compiler.scene import SceneSpec, lower_scene
 
-sapien = pytest.importorskip("sapien")
-
 from fsvla.sim import BuiltScene, build
 from fsvla.sim.shapes import collision_shapes, physx_material
+from tests.conftest import require_sapien
 
+sapien = require_sapien()
 pytestmark = pytest.mark.sim
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
