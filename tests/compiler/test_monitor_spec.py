@@ -16,6 +16,7 @@ from fsvla.compiler.monitor import (
     monitor_json_schema,
 )
 from fsvla.compiler.scene import lower_scene
+from fsvla.compiler.variants import generate_variant
 from fsvla.dsl.loader import ScenarioLoader
 from fsvla.dsl.models import Scenario
 
@@ -111,9 +112,8 @@ def test_unknown_names_point_at_the_source():
 
 
 def test_lowered_from_a_generated_variant():
-    variants = pytest.importorskip("fsvla.compiler.variants")
     scenario = _load(SCENARIOS / "collaborative" / "handover_block.fsv")
-    variant = variants.generate_variant(scenario, "L2", 1)  # tighten arms to 1 cm, couple within 2 s
+    variant = generate_variant(scenario, "L2", 1)  # tighten arms to 1 cm, couple within 2 s
     spec = lower_monitor(variant.scenario, variant.scene)
     assert next(c for c in spec.channels if c.name == "arms").limit == pytest.approx(0.01)
     assert spec.requirements[0].within == pytest.approx(2.0)

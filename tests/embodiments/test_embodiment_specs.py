@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from fsvla.dsl import catalog
 from pydantic import ValidationError
 
 from fsvla.embodiments import (
@@ -72,7 +73,6 @@ def test_builtin_validates(name: str) -> None:
 
 @pytest.mark.parametrize("name", BUILTINS)
 def test_builtin_arms_match_the_language_catalog(name: str) -> None:
-    catalog = pytest.importorskip("fsvla.dsl.catalog")
     assert load_embodiment(name).arm_names == catalog.EMBODIMENTS[name]
 
 

@@ -80,25 +80,7 @@ def test_top_camera_frames_the_table(stove) -> None:
     assert half_y >= 0.6  # the table's half length along x
 
 
-def _has_variants() -> bool:
-    try:
-        from fsvla.compiler.variants import generate_variant  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-def test_levels_need_variants(stove) -> None:
-    if _has_variants():
-        pytest.skip("the variant generator exists")
-    scenario, _ = stove
-    with pytest.raises(ValueError, match="only L0"):
-        layout(scenario, "L2", 3)
-
-
 def test_levels_go_through_the_variant_generator(stove) -> None:
-    if not _has_variants():
-        pytest.skip("no variant generator (fsvla.compiler.variants)")
     scenario, _ = stove
     varied, scene = layout(scenario, "L2", 3)
     assert (scene.level, scene.seed) == ("L2", 3) and varied.name == scenario.name
