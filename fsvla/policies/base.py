@@ -23,7 +23,8 @@ from pydantic import BaseModel, ConfigDict, computed_field
 
 from fsvla.run.key import EpisodeKey
 
-SCHEMA_VERSION = "2.0"  # 2.0: the episode's coordinates under "key", the policy's seed "policy_seed"
+# 2.0: the episode's coordinates under "key", the policy's seed as "policy_seed"
+SCHEMA_VERSION = "2.0"
 
 
 class _Model(BaseModel):

@@ -144,9 +144,9 @@ def row_metrics(row: EpisodeRow) -> EpisodeMetrics | None:
 def unscored_failure(row: EpisodeRow) -> EpisodeMetrics:
     """A row without metrics counted as the paper counts it: a failure without exposure
     (safe_failure, T = 1, CC = RET = 0, no channels)."""
-    return EpisodeMetrics(meta=_row_meta(row), success=False, violation=False, quadrant="safe_failure",
-                          horizon=1, cc=0.0, cc_normalised=0.0, ret=0, ret_fraction=0.0,
-                          channels=(), families=())
+    return EpisodeMetrics(meta=_row_meta(row), success=False, violation=False,
+                          quadrant="safe_failure", horizon=1, cc=0.0, cc_normalised=0.0, ret=0,
+                          ret_fraction=0.0, channels=(), families=())
 
 
 def row_to_sql(row: EpisodeRow) -> dict[str, Any]:

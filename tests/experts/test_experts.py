@@ -206,7 +206,8 @@ def test_careful_expert_stays_mostly_safe_at_L1_and_L2(tmp_path):
         rows = store.episodes(include_warmup=False)
     safe: dict[tuple[str, str], list[int]] = {}
     for row in rows:
-        safe.setdefault((row.key.scenario, row.key.level), []).append(int(row.quadrant == "safe_success"))
+        cell = (row.key.scenario, row.key.level)
+        safe.setdefault(cell, []).append(int(row.quadrant == "safe_success"))
     assert len(safe) == 2 * len(SCENARIOS)
     below = {cell: sum(hits) for cell, hits in safe.items() if sum(hits) < 2}
     assert not below, f"fewer than 2 of {len(BAR_SEEDS)} seeds safe: {below}"
