@@ -21,24 +21,10 @@ import fcl
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.assets.model import Pose, Shape
+from fsvla.compiler.assets.model import Shape
+from fsvla.compiler.pose import pose_matrix
 
 Matrix4 = NDArray[np.float64]
-
-
-def pose_matrix(pose: Pose) -> Matrix4:
-    """The 4 × 4 homogeneous matrix of ``pose``."""
-    w, x, y, z = pose.quaternion
-    n = float(np.sqrt(w * w + x * x + y * y + z * z)) or 1.0
-    w, x, y, z = w / n, x / n, y / n, z / n
-    m = np.eye(4)
-    m[:3, :3] = (
-        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
-        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
-        (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
-    )
-    m[:3, 3] = pose.position
-    return m
 
 
 def fcl_transform(matrix: Matrix4) -> fcl.Transform:
@@ -127,5 +113,5 @@ def min_distance(a: Sequence[CollisionPiece], b: Sequence[CollisionPiece]) -> fl
 
 __all__ = [
     "CollisionPiece", "convex_geometry", "fcl_geometry", "fcl_transform", "min_distance",
-    "pieces_of", "pose_matrix", "shape_vertices", "signed_distance",
+    "pieces_of", "shape_vertices", "signed_distance",
 ]

@@ -1,6 +1,7 @@
-"""Plain 2D/3D placement geometry for lowering layouts: yaw frames, rectangles, support order.
+"""Plain 2D/3D placement geometry for lowering layouts: rectangles, bounds, support order.
 
-Pure functions over floats and tuples (numpy only); no simulator, no FCL. Frames
+Pure functions over floats and tuples (rotations from :mod:`fsvla.compiler.pose`); no
+simulator, no FCL. Frames
 follow the IR (``fsvla.dsl.models``): a support's top-surface frame has its origin at
 the centre of the surface, +x forward, +y left, +z up; yaw is about +z,
 counter-clockwise seen from above. Supports are only ever yawed, never tilted.
@@ -8,45 +9,13 @@ counter-clockwise seen from above. Supports are only ever yawed, never tilted.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-Vec2 = tuple[float, float]
-Vec3 = tuple[float, float, float]
-Quat = tuple[float, float, float, float]
+from .pose import Vec2, Vec3, rotate_xy
 
 #: Footprints may touch; they overlap only when they share more than this (m) on both axes.
 OVERLAP_TOLERANCE = 1e-6
-
-
-def yaw_quaternion(yaw: float) -> Quat:
-    """(w, x, y, z) of a rotation by ``yaw`` rad about +z."""
-    return (math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0))
-
-
-def rotate_xy(xy: Sequence[float], yaw: float) -> Vec2:
-    """``xy`` rotated by ``yaw`` about the origin (counter-clockwise)."""
-    c, s = math.cos(yaw), math.sin(yaw)
-    x, y = float(xy[0]), float(xy[1])
-    return (c * x - s * y, s * x + c * y)
-
-
-def quat_yaw(q: Sequence[float]) -> float:
-    """The yaw of a (w, x, y, z) quaternion (exact for rotations about z only)."""
-    w, x, y, z = (float(v) for v in q)
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
-def quat_matrix(q: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
-    w, x, y, z = (float(v) for v in q)
-    n = math.sqrt(w * w + x * x + y * y + z * z) or 1.0
-    w, x, y, z = w / n, x / n, y / n, z / n
-    return (
-        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
-        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
-        (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
-    )
 
 
 @dataclass(frozen=True)
@@ -101,17 +70,6 @@ def box_corners(center: Sequence[float], half: Sequence[float]) -> list[Vec3]:
         (center[0] + sx * half[0], center[1] + sy * half[1], center[2] + sz * half[2])
         for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)
     ]
-
-
-def transform_points(points: Iterable[Sequence[float]], position: Sequence[float],
-                     quaternion: Sequence[float]) -> list[Vec3]:
-    m = quat_matrix(quaternion)
-    out = []
-    for p in points:
-        out.append(tuple(
-            m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + position[i] for i in range(3)
-        ))
-    return out  # type: ignore[return-value]
 
 
 def aabb(points: Iterable[Sequence[float]]) -> tuple[Vec3, Vec3]:

@@ -70,11 +70,9 @@ from .placement import (
     aabb,
     box_corners,
     placed_rect,
-    rotate_xy,
     support_order,
-    transform_points,
-    yaw_quaternion,
 )
+from .pose import rotate_xy, transform_points, yaw_quat
 
 SCENE_SCHEMA_VERSION = "1.0"
 
@@ -330,7 +328,7 @@ def _place(frame: _Frame, position: Sequence[float], height: float, yaw: float) 
     world_yaw = frame.yaw + yaw
     pose = Pose(
         position=(frame.xy[0] + dx, frame.xy[1] + dy, frame.top_z + height),
-        quaternion=yaw_quaternion(world_yaw),
+        quaternion=yaw_quat(world_yaw),
     )
     return pose, world_yaw
 
@@ -395,7 +393,7 @@ def lower_scene(
         raise LoweringError.of(problems)
     mounts = tuple(
         RobotMount(robot=r.name,
-                   pose=Pose(position=tuple(r.mount.position), quaternion=yaw_quaternion(r.mount.yaw)),
+                   pose=Pose(position=tuple(r.mount.position), quaternion=yaw_quat(r.mount.yaw)),
                    arms=tuple(a.name for a in r.arms))
         for r in spec.robots
     )

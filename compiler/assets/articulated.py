@@ -23,9 +23,9 @@ from pathlib import Path
 
 import jinja2
 
-from .geometry import bounds_of, inertia_tensor, make_pose
+from .geometry import bounds_of, inertia_tensor
 from .materials import PLASTIC, WOOD, Substance, physics_material
-from .model import ArticulatedAsset, BoxShape, ParamValue, Part, Rgba
+from .model import ArticulatedAsset, BoxShape, ParamValue, Part, Pose, Rgba
 from .urdf import parse_urdf
 
 TEMPLATE_DIR = Path(__file__).parent / "templates"
@@ -65,7 +65,7 @@ class BoxLink:
 def box_link(name: str, boxes: Sequence[Panel], substance: Substance = WOOD) -> BoxLink:
     pieces = [
         (
-            BoxShape(pose=make_pose(b.center), half_size=tuple(s / 2.0 for s in b.size)),
+            BoxShape(pose=Pose(position=b.center), half_size=tuple(s / 2.0 for s in b.size)),
             substance.density,
         )
         for b in boxes

@@ -15,20 +15,28 @@ from itertools import pairwise
 import numpy as np
 import trimesh
 
+from ..pose import axis_angle_quat, pose_matrix, quat_mul
 from .geometry import (
     MESH_SECTIONS,
     bounds_of,
     inline_mesh,
-    make_pose,
     mass_properties,
-    pose_matrix,
-    quat_from_axis_angle,
     shape_aabb,
     shape_to_trimesh,
     union_aabb,
 )
 from .materials import Substance, physics_material
-from .model import Appearance, BoxShape, ParamValue, Quat, RigidAsset, Shape, VisualPart
+from .model import (
+    IDENTITY_QUATERNION,
+    Appearance,
+    BoxShape,
+    ParamValue,
+    Pose,
+    Quat,
+    RigidAsset,
+    Shape,
+    VisualPart,
+)
 
 WALL_SEGMENTS = 16  # wall boxes around a container; a multiple of 4 keeps the bounds exact
 
@@ -57,7 +65,7 @@ class BodyBuilder:
         size: Sequence[float],
         center: Sequence[float],
         *,
-        quaternion: Quat | None = None,
+        quaternion: Quat = IDENTITY_QUATERNION,
         substance: Substance | None = None,
         appearance: Appearance | None = None,
         visual: bool = True,
@@ -66,7 +74,7 @@ class BodyBuilder:
         """A box given by its full ``size`` and ``center``: a collision piece and/or a visual."""
         shape = BoxShape(
             name=name,
-            pose=make_pose(center, quaternion),
+            pose=Pose(position=center, quaternion=quaternion),
             half_size=tuple(float(s) / 2.0 for s in size),
         )
         if collide:
@@ -167,29 +175,18 @@ def wall_ring(
         z_mid = (z0 + z1) / 2.0 + thickness / 2.0 * math.sin(tilt)
         for k in range(segments):
             phi = 2.0 * math.pi * k / segments
-            yaw = quat_from_axis_angle((0.0, 0.0, 1.0), phi)
-            lean = quat_from_axis_angle((0.0, 1.0, 0.0), tilt)
+            yaw = axis_angle_quat((0.0, 0.0, 1.0), phi)
+            lean = axis_angle_quat((0.0, 1.0, 0.0), tilt)
             builder.add_collision(
                 BoxShape(
                     name=f"{name}_{index}_{k}",
-                    pose=make_pose(
-                        (r_mid * math.cos(phi), r_mid * math.sin(phi), z_mid), _compose(yaw, lean)
+                    pose=Pose(
+                        position=(r_mid * math.cos(phi), r_mid * math.sin(phi), z_mid),
+                        quaternion=quat_mul(yaw, lean),
                     ),
                     half_size=(thickness / 2.0, width / 2.0, length / 2.0),
                 )
             )
-
-
-def _compose(first: Quat, second: Quat) -> Quat:
-    """The rotation ``first ∘ second`` (apply ``second``, then ``first``)."""
-    w1, x1, y1, z1 = first
-    w2, x2, y2, z2 = second
-    return (
-        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-    )
 
 
 def _radius_at(profile: Sequence[tuple[float, float]], z: float) -> float:

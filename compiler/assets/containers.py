@@ -10,10 +10,11 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 
+from ..pose import axis_angle_quat
 from .bodies import BodyBuilder, revolved_shell, wall_ring
-from .geometry import make_pose, quat_from_axis_angle, shape_to_trimesh
+from .geometry import shape_to_trimesh
 from .materials import ALUMINIUM, CERAMIC, GLASS, PLASTIC, Substance
-from .model import CylinderShape, ParamValue, RigidAsset
+from .model import CylinderShape, ParamValue, Pose, RigidAsset
 
 Profile = Sequence[tuple[float, float]]  # (outer radius, z), bottom to rim
 
@@ -34,7 +35,7 @@ def _shell(
     body.add_collision(
         CylinderShape(
             name="base",
-            pose=make_pose((0.0, 0.0, base / 2.0)),
+            pose=Pose(position=(0.0, 0.0, base / 2.0)),
             radius=r_bottom,
             half_length=base / 2.0,
         )
@@ -47,7 +48,7 @@ def _shell(
 def _cavity(radius: float, base: float, height: float) -> CylinderShape:
     return CylinderShape(
         name="cavity",
-        pose=make_pose((0.0, 0.0, (base + height) / 2.0)),
+        pose=Pose(position=(0.0, 0.0, (base + height) / 2.0)),
         radius=radius,
         half_length=(height - base) / 2.0,
     )
@@ -203,7 +204,7 @@ def _add_spout(body: BodyBuilder, start: tuple[float, float], radius: float, len
     centre = (start[0] + direction[0] * length / 2.0, 0.0, start[1] + direction[2] * length / 2.0)
     spout = CylinderShape(
         name="spout",
-        pose=make_pose(centre, quat_from_axis_angle((0, 1, 0), angle)),
+        pose=Pose(position=centre, quaternion=axis_angle_quat((0, 1, 0), angle)),
         radius=radius,
         half_length=length / 2.0,
     )

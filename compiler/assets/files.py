@@ -16,7 +16,7 @@ import numpy as np
 import trimesh
 
 from .decomposition import Method, convex_pieces
-from .geometry import bounds_of, inline_mesh, make_pose, mass_properties, shape_aabb, union_aabb
+from .geometry import bounds_of, inline_mesh, mass_properties, shape_aabb, union_aabb
 from .materials import Substance, physics_material
 from .model import (
     ArticulatedAsset,
@@ -24,6 +24,7 @@ from .model import (
     MeshFile,
     ParamValue,
     Part,
+    Pose,
     RigidAsset,
     VisualPart,
 )
@@ -103,7 +104,7 @@ def load_mesh_asset(
     visual = VisualPart(
         name="mesh",
         mesh=MeshFile(path=str(path), scale=(scale, scale, scale)),
-        pose=make_pose(-offset),
+        pose=Pose(position=-offset),
     )
     bounds, footprint = bounds_of(
         *union_aabb([shape_aabb(s) for s in collision] + [tuple(mesh.bounds)])

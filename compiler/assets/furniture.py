@@ -8,9 +8,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from .bodies import BodyBuilder
-from .geometry import make_pose, shape_to_trimesh
+from .geometry import shape_to_trimesh
 from .materials import ENAMEL, HOT_GLOW, LAMINATE, PLASTIC, WOOD
-from .model import CylinderShape, ParamValue, RigidAsset
+from .model import CylinderShape, ParamValue, Pose, RigidAsset
 
 PLATE_GLOW_RADIUS_FRACTION = 0.35  # heating plate radius / smaller side of the stove
 
@@ -70,7 +70,7 @@ def build_stove(params: Mapping[str, ParamValue]) -> RigidAsset:
     plate_radius = PLATE_GLOW_RADIUS_FRACTION * min(width, depth)
     plate = CylinderShape(
         name="heating_plate",
-        pose=make_pose((0.0, 0.0, height)),
+        pose=Pose(position=(0.0, 0.0, height)),
         radius=plate_radius,
         half_length=0.001,
     )

@@ -1,6 +1,7 @@
-"""Geometry of shapes: rotations, meshes, bounding boxes and mass properties.
+"""Geometry of shapes: meshes, bounding boxes and mass properties.
 
-Pure functions over the models of :mod:`.model`; numpy, scipy and trimesh only.
+Pure functions over the models of :mod:`.model`; numpy and trimesh only (rotations come
+from :mod:`fsvla.compiler.pose`).
 """
 
 from __future__ import annotations
@@ -10,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import trimesh
-from scipy.spatial.transform import Rotation
 
+from ..pose import matrix_to_quat, pose_matrix, quat_to_matrix
 from .model import (
     Bounds,
     BoxShape,
@@ -21,7 +22,6 @@ from .model import (
     Footprint,
     InlineMesh,
     MeshFile,
-    Pose,
     Quat,
     Shape,
     SphereShape,
@@ -29,43 +29,6 @@ from .model import (
 )
 
 MESH_SECTIONS = 32  # facets around a visual cylinder or revolved profile; a multiple of 4
-
-
-# --- rotations --------------------------------------------------------------------------
-
-
-def quat_from_axis_angle(axis: Sequence[float], angle: float) -> Quat:
-    """The (w, x, y, z) quaternion rotating by ``angle`` radians about ``axis``."""
-    direction = np.asarray(axis, dtype=float)
-    x, y, z, w = Rotation.from_rotvec(direction / np.linalg.norm(direction) * angle).as_quat()
-    return (float(w), float(x), float(y), float(z))
-
-
-def quat_to_matrix(quaternion: Quat) -> np.ndarray:
-    w, x, y, z = quaternion
-    return Rotation.from_quat([x, y, z, w]).as_matrix()
-
-
-def matrix_to_quat(matrix: np.ndarray) -> Quat:
-    x, y, z, w = Rotation.from_matrix(matrix).as_quat()
-    if w < 0:
-        x, y, z, w = -x, -y, -z, -w
-    return (float(w), float(x), float(y), float(z))
-
-
-def pose_matrix(pose: Pose) -> np.ndarray:
-    """The 4×4 homogeneous matrix of a pose."""
-    matrix = np.eye(4)
-    matrix[:3, :3] = quat_to_matrix(pose.quaternion)
-    matrix[:3, 3] = pose.position
-    return matrix
-
-
-def make_pose(position: Sequence[float] = (0.0, 0.0, 0.0), quaternion: Quat | None = None) -> Pose:
-    xyz = tuple(float(v) for v in position)
-    if quaternion is None:
-        return Pose(position=xyz)
-    return Pose(position=xyz, quaternion=quaternion)
 
 
 # --- meshes -----------------------------------------------------------------------------

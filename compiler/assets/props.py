@@ -6,9 +6,9 @@ from collections.abc import Mapping
 from dataclasses import replace
 
 from .bodies import BodyBuilder, revolved_solid
-from .geometry import inline_mesh, make_pose, shape_to_trimesh
+from .geometry import inline_mesh, shape_to_trimesh
 from .materials import FILLED_BOTTLE, PLATE_CERAMIC, STEEL, WOOD
-from .model import ConvexMeshShape, CylinderShape, ParamValue, RigidAsset
+from .model import ConvexMeshShape, CylinderShape, ParamValue, Pose, RigidAsset
 
 PAINTED_WOOD = replace(WOOD, name="painted_wood", color=(0.80, 0.18, 0.15, 1.0))
 
@@ -25,7 +25,7 @@ def build_plate(params: Mapping[str, ParamValue]) -> RigidAsset:
     r, t = float(params["radius"]), float(params["thickness"])
     body = BodyBuilder(kind="plate", params=params, substance=PLATE_CERAMIC)
     disc = CylinderShape(
-        name="plate", pose=make_pose((0.0, 0.0, t / 2.0)), radius=r, half_length=t / 2.0
+        name="plate", pose=Pose(position=(0.0, 0.0, t / 2.0)), radius=r, half_length=t / 2.0
     )
     body.add_collision(disc)
     body.add_visual("plate", shape_to_trimesh(disc))
@@ -40,7 +40,7 @@ def build_bottle(params: Mapping[str, ParamValue]) -> RigidAsset:
     body.add_collision(
         CylinderShape(
             name="body",
-            pose=make_pose((0.0, 0.0, shoulder_low / 2.0)),
+            pose=Pose(position=(0.0, 0.0, shoulder_low / 2.0)),
             radius=r,
             half_length=shoulder_low / 2.0,
         )
@@ -50,7 +50,7 @@ def build_bottle(params: Mapping[str, ParamValue]) -> RigidAsset:
     body.add_collision(
         CylinderShape(
             name="neck",
-            pose=make_pose((0.0, 0.0, (shoulder_high + h) / 2.0)),
+            pose=Pose(position=(0.0, 0.0, (shoulder_high + h) / 2.0)),
             radius=neck,
             half_length=(h - shoulder_high) / 2.0,
         )

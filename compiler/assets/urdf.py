@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import trimesh
-from scipy.spatial.transform import Rotation
 
-from .geometry import inline_mesh, make_pose, matrix_to_quat, pose_matrix, shape_aabb, union_aabb
+from ..pose import pose_matrix, rpy_quat
+from .geometry import inline_mesh, shape_aabb, union_aabb
 from .model import (
     BoxShape,
     ConvexMeshShape,
@@ -214,8 +214,8 @@ def _origin(element: ET.Element | None, scale: float) -> Pose:
     xyz = np.asarray(_floats(element.get("xyz", "0 0 0"), 3)) * scale
     rpy = _floats(element.get("rpy", "0 0 0"), 3)
     if not any(rpy):
-        return make_pose(xyz)
-    return make_pose(xyz, matrix_to_quat(Rotation.from_euler("xyz", rpy).as_matrix()))
+        return Pose(position=xyz)
+    return Pose(position=xyz, quaternion=rpy_quat(rpy))
 
 
 def _floats(text: str, count: int) -> tuple[float, ...]:

@@ -19,8 +19,17 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import trimesh
 
-from .geometry import bounds_of, inline_mesh, make_pose, shape_aabb, shape_to_trimesh, union_aabb
-from .model import Appearance, BoxShape, CylinderShape, ParamValue, Shape, VisualPart, ZoneAsset
+from .geometry import bounds_of, inline_mesh, shape_aabb, shape_to_trimesh, union_aabb
+from .model import (
+    Appearance,
+    BoxShape,
+    CylinderShape,
+    ParamValue,
+    Pose,
+    Shape,
+    VisualPart,
+    ZoneAsset,
+)
 
 MARKER_THICKNESS = 0.002
 STRIPE_WIDTH = 0.02  # width of one stripe or ring of a striped marker
@@ -82,7 +91,7 @@ def _area_marker(kind: str, params: Mapping[str, ParamValue]) -> ZoneAsset:
         sx, sy = (float(v) for v in size)
         region: Shape = BoxShape(
             name="region",
-            pose=make_pose((0.0, 0.0, region_height / 2.0)),
+            pose=Pose(position=(0.0, 0.0, region_height / 2.0)),
             half_size=(sx / 2.0, sy / 2.0, region_height / 2.0),
         )
         if kind == "heat_zone":
@@ -93,7 +102,7 @@ def _area_marker(kind: str, params: Mapping[str, ParamValue]) -> ZoneAsset:
         r = float(radius)
         region = CylinderShape(
             name="region",
-            pose=make_pose((0.0, 0.0, region_height / 2.0)),
+            pose=Pose(position=(0.0, 0.0, region_height / 2.0)),
             radius=r,
             half_length=region_height / 2.0,
         )
@@ -120,7 +129,7 @@ def _edge_marker(params: Mapping[str, ParamValue], support_size: Sequence[float]
     line_centre = (centre[0] - dx * (width - line) / 2.0, centre[1] - dy * (width - line) / 2.0)
     region = BoxShape(
         name="region",
-        pose=make_pose((*centre, MARKER_THICKNESS / 2.0)),
+        pose=Pose(position=(*centre, MARKER_THICKNESS / 2.0)),
         half_size=(band_x / 2.0, band_y / 2.0, MARKER_THICKNESS / 2.0),
     )
     visuals = [
@@ -141,14 +150,14 @@ def _corridor(params: Mapping[str, ParamValue]) -> ZoneAsset:
     walls = [
         BoxShape(
             name=name,
-            pose=make_pose((0.0, side * (width + t) / 2.0, wall_h / 2.0)),
+            pose=Pose(position=(0.0, side * (width + t) / 2.0, wall_h / 2.0)),
             half_size=(length / 2.0, t / 2.0, wall_h / 2.0),
         )
         for side, name in ((-1.0, "wall_neg_y"), (1.0, "wall_pos_y"))
     ]
     region = BoxShape(
         name="region",
-        pose=make_pose((0.0, 0.0, wall_h / 2.0)),
+        pose=Pose(position=(0.0, 0.0, wall_h / 2.0)),
         half_size=(length / 2.0, width / 2.0, wall_h / 2.0),
     )
     visuals = [_part(w.name, shape_to_trimesh(w), WALL_GREY) for w in walls]

@@ -34,10 +34,11 @@ from fsvla.embodiments.spec import WorkspaceSpec
 
 from ..collision import min_distance
 from ..placement import OVERLAP_TOLERANCE, Rect, placed_rect
+from ..pose import yaw_matrix
 from ..scene import WORLD, overhang_axis
 from .errors import cm
 from .layout import Draw, Frame, Layout, rect_of
-from .solids import Solid, gap_below, robot_base, solid_of_asset, solid_of_shapes, yaw_matrix
+from .solids import Solid, gap_below, robot_base, solid_of_asset, solid_of_shapes
 from .start import Keep, edge_margin, edge_points, keeps_of
 
 #: How far (m) outside an arm's ``workspace`` box a task object may stand: the boxes are
@@ -80,7 +81,7 @@ class Checker:
         self.robots = []
         for robot in embodiment.robots:
             base = robot_base(robot.name, ROBOT_BASE_RADIUS, ROBOT_BASE_HEIGHT)
-            base.move(yaw_matrix(*robot.mount.position, robot.mount.yaw))
+            base.move(yaw_matrix(robot.mount.position, robot.mount.yaw))
             self.robots.append(base)
         self._clutter: dict[tuple[str, int], Solid] = {}
         self.corridors = {z.name for z in layout.scenario.zones if z.kind == "corridor"}
@@ -268,13 +269,13 @@ class Checker:
     def _move(self, draw: Draw, frames: dict[str, Frame]) -> None:
         for name, solid in self.solids.items():
             f = frames[name]
-            solid.move(yaw_matrix(f.x, f.y, f.z, f.yaw))
+            solid.move(yaw_matrix((f.x, f.y, f.z), f.yaw))
         for item in draw.clutter:
             f = frames[item.name]
-            self._clutter_solid(item.name, item.palette).move(yaw_matrix(f.x, f.y, f.z, f.yaw))
+            self._clutter_solid(item.name, item.palette).move(yaw_matrix((f.x, f.y, f.z), f.yaw))
         for zone in self.layout.markers:
             f = frames[zone]
-            matrix = yaw_matrix(f.x, f.y, f.z, f.yaw)
+            matrix = yaw_matrix((f.x, f.y, f.z), f.yaw)
             self.regions[zone].move(matrix)
             if zone in self.walls:
                 self.walls[zone].move(matrix)

@@ -19,7 +19,8 @@ from fsvla.dsl.catalog import ASSETS
 from fsvla.dsl.models import ObjectSpec, ParamValue, Placement, Scenario, SourceRef, ZoneSpec
 
 from ..assets.registry import merge_params
-from ..placement import Rect, rotate_xy, support_order
+from ..placement import Rect, support_order
+from ..pose import rotate_xy
 from ..scene import WORLD, surface_height
 
 #: Distractors for ``clutter``: catalogue kinds with everyday sizes (SI). The blocks are

@@ -23,10 +23,10 @@ from ..collision import (
     CollisionPiece,
     Matrix4,
     fcl_geometry,
-    pose_matrix,
     shape_vertices,
     signed_distance,
 )
+from ..pose import pose_matrix
 
 _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
 
@@ -193,14 +193,4 @@ def _half_extents(shape: Shape) -> tuple[float, float, float]:
     return (shape.radius,) * 3  # sphere
 
 
-def yaw_matrix(x: float, y: float, z: float, yaw: float) -> Matrix4:
-    """The world matrix of a frame at (x, y, z) turned by ``yaw`` about +z."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    m = np.eye(4)
-    m[0, 0], m[0, 1], m[1, 0], m[1, 1] = c, -s, s, c
-    m[:3, 3] = (x, y, z)
-    return m
-
-
-__all__ = ["Solid", "gap_below", "link_frames", "robot_base", "solid_of_asset", "solid_of_shapes",
-           "yaw_matrix"]
+__all__ = ["Solid", "gap_below", "link_frames", "robot_base", "solid_of_asset", "solid_of_shapes"]

@@ -18,7 +18,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from .frames import Quat, Vec3, look_at_quat
+from fsvla.compiler.pose import Quat, Vec3, look_at_quat
 
 Axis = Literal["+x", "-x", "+y", "-y", "+z", "-z"]
 

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fsvla.compiler.monitor import RobotEntity, ZoneEntity
-from fsvla.embodiments.frames import quat_to_matrix
+from fsvla.compiler.pose import quat_to_matrix, transform_points
 
 from .world import World
 
@@ -69,7 +69,7 @@ class ArmClearance:
                     continue
                 v = np.asarray(shape.get_vertices(), dtype=np.float64) * np.asarray(shape.scale)
                 pose = shape.local_pose
-                parts.append(v @ quat_to_matrix(pose.q).T + np.asarray(pose.p))
+                parts.append(transform_points(v, pose.p, pose.q))
             if parts:
                 self._vertices[i] = np.concatenate(parts)
 
@@ -101,10 +101,12 @@ class ArmClearance:
             return float("inf")
         model = self.kin._model
         model.compute_forward_kinematics(self.kin._full(q))
-        points: dict[int, NDArray[np.float64]] = {}
-        for i, v in self._vertices.items():
-            pose = self._root * model.get_link_pose(i)
-            points[i] = v @ quat_to_matrix(pose.q).T + np.asarray(pose.p)
+        poses = [self._root * model.get_link_pose(i) for i in self._vertices]
+        rotations = quat_to_matrix([pose.q for pose in poses])  # one conversion for all links
+        points: dict[int, NDArray[np.float64]] = {
+            i: v @ R.T + np.asarray(pose.p)
+            for (i, v), R, pose in zip(self._vertices.items(), rotations, poses)
+        }
         best = float("inf")
         for indices, ref, limit in self._checks:
             pts = [points[i] for i in indices if i in points]

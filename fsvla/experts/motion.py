@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.embodiments.frames import matrix_to_quat, quat_to_matrix
+from fsvla.compiler.pose import matrix_to_quat, quat_to_matrix, rotation_angle, slerp
 
 #: Largest joint step (rad) between two IK solves of one segment before it is split.
 MAX_JOINT_STEP = 0.12
@@ -70,26 +70,6 @@ class Segment:
     # branch that also reaches these poses (the grasp below a hover point)
     joints: dict[str, NDArray[np.float64]] = field(default_factory=dict)  # joint_space: the
     # end joints the plan chose (a branch that follows a path after it), instead of IK
-
-
-def slerp(R0: NDArray[np.float64], R1: NDArray[np.float64], s: float) -> NDArray[np.float64]:
-    """Rotation a fraction ``s`` of the way from ``R0`` to ``R1`` (about one axis)."""
-    rel = R0.T @ R1
-    angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
-    if angle < 1e-9:
-        return R1.copy()
-    axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
-    if np.linalg.norm(axis) < 1e-9:  # a half turn: any axis perpendicular works
-        w, v = np.linalg.eigh(rel + rel.T)
-        axis = v[:, np.argmax(w)]
-    axis = axis / np.linalg.norm(axis)
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    a = s * angle
-    return R0 @ (np.eye(3) + np.sin(a) * k + (1 - np.cos(a)) * k @ k)
-
-
-def rotation_angle(R0: NDArray[np.float64], R1: NDArray[np.float64]) -> float:
-    return float(np.arccos(np.clip((np.trace(R0.T @ R1) - 1.0) / 2.0, -1.0, 1.0)))
 
 
 class ArmDriver:
@@ -435,5 +415,4 @@ def current_pose(arm) -> Pose:
     return Pose.of(pose.p, quat_to_matrix(pose.q))
 
 
-__all__ = ["ArmDriver", "Pose", "Segment", "Step", "current_pose", "expand", "rotation_angle",
-           "slerp"]
+__all__ = ["ArmDriver", "Pose", "Segment", "Step", "current_pose", "expand"]

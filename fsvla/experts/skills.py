@@ -16,6 +16,8 @@ from itertools import pairwise
 import numpy as np
 from numpy.typing import NDArray
 
+from fsvla.compiler.pose import rotation_angle, slerp
+
 from .motion import Pose, Segment
 from .style import Style
 from .world import World
@@ -200,7 +202,7 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
     hand off the arc); the answer nearest the arm's present joints, None if none is found.
     Candidates: IK answers for ``path[0]``, and answers for its far end walked back along
     the path (a pose that few seeds solve comfortably is often reached that way)."""
-    from .motion import ArmDriver, rotation_angle, slerp
+    from .motion import ArmDriver
 
     kin = world.kinematics(arm)
     now = np.asarray(world.robot.arm(arm).qpos(), dtype=np.float64)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fsvla.compiler.pose import axis_angle_matrix
 from fsvla.dsl.models import predicates_in
 
 from . import grasps
@@ -305,7 +306,7 @@ def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
 
     R0 = world.grasp_frame(arm, approach, UP)
     loaded = world.robot.arm(arm)
-    for R in (R0, _rotation(approach / np.linalg.norm(approach), np.pi) @ R0):
+    for R in (R0, axis_angle_matrix(approach, np.pi) @ R0):
         driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm), loaded.qpos(), 1.0)
         tcp = Pose(start, R)
         if driver.branch_that_tracks(tcp, tcp.moved(pull)) is not None:
@@ -404,11 +405,6 @@ def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
     yield from plan_move_part(world, style, target, 0.0)
 
 
-def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
-
-
 #: Lid angle (rad) the careful expert lifts a lid to: past vertical, so that it falls
 #: open onto its stop instead of shut when the hand leaves it.
 LID_PAST_VERTICAL = np.deg2rad(95.0)
@@ -428,7 +424,7 @@ def lift_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     axis = axis / np.linalg.norm(axis)
     span = joint.upper - joint.lower
     now = world.open_fraction(body) * span
-    closed = _rotation(axis, -now) @ link.R  # the lid frame when shut
+    closed = axis_angle_matrix(axis, -now) @ link.R  # the lid frame when shut
     c, half = np.asarray(knob.pose.position), np.asarray(knob.half_size)
     # under the knob's front edge (the fingertips reach ~1 cm past the TCP), the closed
     # fingers' half thickness and a little more below it
@@ -436,7 +432,7 @@ def lift_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     toward_hinge = -np.sign(c[0]) * np.array([1.0, 0.0, 0.0])  # the knob is at -x
 
     def pose_at(theta: float, near: np.ndarray | None = None) -> Pose:
-        R = _rotation(axis, theta) @ closed
+        R = axis_angle_matrix(axis, theta) @ closed
         approach = R @ toward_hinge
         return Pose(link.p + R @ local, world.grasp_frame(arm, approach, R[:, 2], near=near))
 
@@ -450,7 +446,7 @@ def lift_lid(world: World, style: Style, body: str, angle: float) -> Plan:
         # limit half way up: the hand leaves the arc and jams against the lid), the hand
         # turned either way about its approach (a fist is symmetric), each pose of the
         # arc the turn nearest the one before
-        flipped = start.R @ _rotation(world.approach_axis(arm), np.pi)
+        flipped = start.R @ axis_angle_matrix(world.approach_axis(arm), np.pi)
         options = [_chained(pose_at, now, angle, R0) for R0 in (start.R, flipped)]
         arc = next((a for a in options if branch_for_path(
             world, arm, (a[0].moved(back_off), *a)) is not None), options[0])
@@ -550,9 +546,7 @@ def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
     tcp = world.current_pose(arm)
     yield from transit(world, style, arm, Pose(over, tcp.R), below=0.15, exclude=(obj, target))
     axis = horizontal(world.base_position(arm) - over)
-    angle = np.deg2rad(100)
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    tilt = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+    tilt = axis_angle_matrix(axis, np.deg2rad(100))
     yield Segment({arm: Pose(over, tilt @ tcp.R)}, speed=style.approach_speed, settle=20,
                   label="pour")
     yield Segment({arm: Pose(over, tcp.R)}, speed=style.approach_speed, label="unpour")

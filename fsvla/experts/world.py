@@ -12,9 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.embodiments.frames import AXES, quat_to_matrix
+from fsvla.compiler.pose import AXES, quat_to_matrix, rotation_angle, rotation_between
 
-from .motion import Pose, rotation_angle
+from .motion import Pose
 
 
 @dataclass(frozen=True)
@@ -214,8 +214,6 @@ class World:
 
 def _z_only(R: NDArray[np.float64]) -> NDArray[np.float64]:
     """The smallest rotation taking +z to R's +z (tilt without heading)."""
-    from fsvla.embodiments.frames import rotation_between
-
     return rotation_between(np.array([0.0, 0.0, 1.0]), R[:, 2])
 
 

@@ -25,7 +25,7 @@ either group moves by more than ``POSE_TOLERANCE``.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +44,7 @@ from fsvla.compiler.assets.model import (
     SphereShape,
 )
 from fsvla.compiler.collision import CollisionPiece, pieces_of, signed_distance
+from fsvla.compiler.pose import pose_matrix, quat_mul
 
 from . import kernels
 from .state import Matrix4
@@ -61,13 +62,6 @@ _POINT_SECTIONS = 12  # rim points of a round shape for footprint / lowest-point
 _Z_TO_X = (0.7071067811865476, 0.0, 0.7071067811865476, 0.0)
 
 
-def _quat_mul(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float, float]:
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return (w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2)
-
-
 def shapes_of_sapien(component: Any) -> list[Shape]:
     """Compiler shapes for the collision shapes of a SAPIEN rigid component or link."""
     import sapien
@@ -83,10 +77,10 @@ def shapes_of_sapien(component: Any) -> list[Shape]:
         elif isinstance(sh, physx.PhysxCollisionShapeSphere):
             shapes.append(SphereShape(pose=Pose(position=p, quaternion=q), radius=float(sh.radius)))
         elif isinstance(sh, physx.PhysxCollisionShapeCapsule):
-            shapes.append(CapsuleShape(pose=Pose(position=p, quaternion=_quat_mul(q, _Z_TO_X)),
+            shapes.append(CapsuleShape(pose=Pose(position=p, quaternion=quat_mul(q, _Z_TO_X)),
                                        radius=float(sh.radius), half_length=float(sh.half_length)))
         elif isinstance(sh, physx.PhysxCollisionShapeCylinder):
-            shapes.append(CylinderShape(pose=Pose(position=p, quaternion=_quat_mul(q, _Z_TO_X)),
+            shapes.append(CylinderShape(pose=Pose(position=p, quaternion=quat_mul(q, _Z_TO_X)),
                                         radius=float(sh.radius), half_length=float(sh.half_length)))
         elif isinstance(sh, physx.PhysxCollisionShapeConvexMesh):
             vertices = np.asarray(sh.vertices, dtype=np.float64) * np.asarray(sh.scale, dtype=np.float64)
@@ -99,7 +93,7 @@ def shapes_of_sapien(component: Any) -> list[Shape]:
 
 def _local_points(shape: Shape, base_dir: Path | None) -> NDArray[np.float64]:
     if shape.type == "convex_mesh" and shape.mesh.type == "file":
-        from fsvla.compiler.collision import pose_matrix, shape_vertices
+        from fsvla.compiler.collision import shape_vertices
 
         v = shape_vertices(shape, base_dir)
         m = pose_matrix(shape.pose)

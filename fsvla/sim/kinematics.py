@@ -13,7 +13,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.embodiments.frames import Quat, Vec3, matrix_to_quat, point_axis, quat_to_matrix
+from fsvla.compiler.pose import (
+    Quat,
+    Vec3,
+    matrix_to_quat,
+    point_axis,
+    quat_to_matrix,
+    rotation_angle,
+)
 
 from .robot import LoadedArm
 
@@ -116,8 +123,7 @@ class ArmKinematics:
         arm_q = np.asarray(full, dtype=np.float64)[list(self.arm.joint_indices)]
         reached = self.tcp_pose(arm_q)
         position_error = float(np.linalg.norm(np.asarray(reached.p) - np.asarray(position)))
-        relative = quat_to_matrix(reached.q).T @ quat_to_matrix(orientation)
-        rotation_error = float(np.arccos(np.clip((np.trace(relative) - 1) / 2, -1.0, 1.0)))
+        rotation_error = rotation_angle(quat_to_matrix(reached.q), quat_to_matrix(orientation))
         within = bool(
             np.all(arm_q >= self.limits[:, 0] - 1e-6) and np.all(arm_q <= self.limits[:, 1] + 1e-6)
         )

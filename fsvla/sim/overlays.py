@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fsvla.compiler.assets.model import Pose
+from fsvla.compiler.pose import quat_yaw, rotate_xy
 from fsvla.compiler.scene import SceneSpec
 from fsvla.dsl.models import Scenario
 
@@ -101,20 +102,14 @@ class Overlay:
         return vertices, np.asarray(faces, dtype=np.int64)
 
 
-def _yaw(q: tuple[float, float, float, float]) -> float:
-    w, x, y, z = q
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def _shape_outline(shape: Any, frame: Pose) -> Outline | None:
     """The footprint of a box or cylinder shape given in ``frame`` (a yaw-only pose)."""
-    yaw = _yaw(frame.quaternion)
-    c, s = math.cos(yaw), math.sin(yaw)
-    px, py, _ = shape.pose.position
-    center = (frame.position[0] + c * px - s * py, frame.position[1] + s * px + c * py)
+    yaw = quat_yaw(frame.quaternion)
+    dx, dy = rotate_xy(shape.pose.position, yaw)
+    center = (frame.position[0] + dx, frame.position[1] + dy)
     z = frame.position[2]
     if shape.type == "box":
-        return Outline(center, yaw + _yaw(shape.pose.quaternion), z,
+        return Outline(center, yaw + quat_yaw(shape.pose.quaternion), z,
                        half=(shape.half_size[0], shape.half_size[1]))
     if shape.type in ("cylinder", "capsule", "sphere"):
         return Outline(center, yaw, z, radius=shape.radius)
@@ -133,10 +128,9 @@ def reference_outlines(spec: SceneSpec, name: str) -> list[Outline]:
         return []
     fp = body.asset.footprint
     mid = ((fp.min_xy[0] + fp.max_xy[0]) / 2, (fp.min_xy[1] + fp.max_xy[1]) / 2)
-    yaw = _yaw(body.pose.quaternion)
-    c, s = math.cos(yaw), math.sin(yaw)
-    center = (body.pose.position[0] + c * mid[0] - s * mid[1],
-              body.pose.position[1] + s * mid[0] + c * mid[1])
+    yaw = quat_yaw(body.pose.quaternion)
+    dx, dy = rotate_xy(mid, yaw)
+    center = (body.pose.position[0] + dx, body.pose.position[1] + dy)
     radius = body.asset.params.get("radius")
     if isinstance(radius, (int, float)) and not isinstance(radius, bool):
         return [Outline(center, yaw, body.pose.position[2], radius=float(radius))]

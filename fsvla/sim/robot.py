@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from fsvla.compiler.pose import yaw_quat
 from fsvla.embodiments.assets import resolve_asset
-from fsvla.embodiments.frames import yaw_quat
 from fsvla.embodiments.spec import ArmSpec, DriveSpec, EmbodimentSpec, MountSpec, RobotSpec
 
 from .urdf import prepare_urdf

@@ -12,12 +12,14 @@ images a policy receives.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from fsvla.compiler.pose import axis_angle_quat, look_along_quat, yaw_quat
 from fsvla.sim.builder import BuiltScene
 
 from .vision import CameraShift, Patch, VisionPerturbation
@@ -182,8 +184,8 @@ class VisionApplier:
 
     def _move_cameras(self, shift: CameraShift) -> None:
         sapien = self._sapien
-        turn = (sapien.Pose(q=_axis_angle((0.0, 0.0, 1.0), shift.yaw))
-                * sapien.Pose(q=_axis_angle((0.0, 1.0, 0.0), shift.pitch)))
+        turn = (sapien.Pose(q=list(yaw_quat(shift.yaw)))
+                * sapien.Pose(q=list(axis_angle_quat((0.0, 1.0, 0.0), shift.pitch))))
         for entity, pose in self._original.cameras:
             moved = sapien.Pose(np.asarray(pose.p) + np.asarray(shift.offset), pose.q)
             entity.pose = moved * turn
@@ -207,7 +209,7 @@ class VisionApplier:
             for component in list(occluder.components):
                 if isinstance(component, sapien.physx.PhysxRigidBaseComponent):
                     occluder.remove_component(component)
-            occluder.pose = sapien.Pose(at, _look_quaternion(ray / distance))
+            occluder.pose = _facing(sapien, ray, at)
             self._occluders.append(occluder)
 
     def _extent(self, target: str) -> tuple[NDArray[np.float64], float]:
@@ -296,27 +298,13 @@ def patch_pixels(seed: int, size: int) -> NDArray[np.uint8]:
     return np.kron(blocks, np.ones((repeat, repeat, 1), dtype=np.uint8))[:size, :size]
 
 
-def _axis_angle(axis: tuple[float, float, float], angle: float) -> list[float]:
-    s = math.sin(angle / 2.0)
-    return [math.cos(angle / 2.0), axis[0] * s, axis[1] * s, axis[2] * s]
-
-
-def _look_quaternion(direction: NDArray[np.float64]) -> list[float]:
-    """A rotation taking +x to ``direction`` (unit), keeping +z as close to up as it can."""
-    from fsvla.embodiments.frames import matrix_to_quat
-
-    x = direction / np.linalg.norm(direction)
-    up = np.array([0.0, 0.0, 1.0]) if abs(x[2]) < 0.99 else np.array([1.0, 0.0, 0.0])
-    y = np.cross(up, x)
-    y /= np.linalg.norm(y)
-    z = np.cross(x, y)
-    return list(matrix_to_quat(np.stack([x, y, z], axis=1)))
-
-
-def _facing(sapien: Any, direction: tuple[float, float, float]) -> Any:
-    """The pose of a directional light shining along ``direction`` (its +x)."""
+def _facing(sapien: Any, direction: Sequence[float], at: Sequence[float] = (0.0, 0.0, 0.0)) -> Any:
+    """The pose at ``at`` whose +x points along ``direction`` (a directional light's, an
+    occluder's), its +z as near up as it can be (+x when ``direction`` is near vertical)."""
     d = np.asarray(direction, dtype=np.float64)
-    return sapien.Pose(q=_look_quaternion(d / (np.linalg.norm(d) or 1.0)))
+    d = d / (np.linalg.norm(d) or 1.0)
+    up = (0.0, 0.0, 1.0) if abs(d[2]) < 0.99 else (1.0, 0.0, 0.0)
+    return sapien.Pose(np.asarray(at, dtype=np.float64), list(look_along_quat(d, up)))
 
 
 __all__ = ["VisionApplier", "patch_pixels", "pattern_image"]

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 from fsvla.compiler.assets.model import (
@@ -15,18 +13,12 @@ from fsvla.compiler.assets.model import (
     Pose,
     SphereShape,
 )
-from fsvla.compiler.collision import min_distance, pieces_of, pose_matrix
+from fsvla.compiler.collision import min_distance, pieces_of
+from fsvla.compiler.pose import pose_matrix
 
 
 def _at(x: float, y: float = 0.0, z: float = 0.0) -> np.ndarray:
     return pose_matrix(Pose(position=(x, y, z)))
-
-
-def test_pose_matrix_rotates_about_z() -> None:
-    half = math.sqrt(0.5)
-    m = pose_matrix(Pose(position=(1.0, 2.0, 3.0), quaternion=(half, 0.0, 0.0, half)))
-    assert np.allclose(m[:3, :3] @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
-    assert np.allclose(m[:3, 3], [1.0, 2.0, 3.0])
 
 
 @pytest.mark.parametrize(

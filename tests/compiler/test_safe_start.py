@@ -12,8 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fsvla.compiler.assets.model import ArticulatedAsset
-from fsvla.compiler.collision import min_distance, pieces_of, pose_matrix
+from fsvla.compiler.collision import min_distance, pieces_of
 from fsvla.compiler.monitor import lower_monitor
+from fsvla.compiler.pose import pose_matrix
 from fsvla.compiler.variants import Variant, VariantError, generate_variant
 from fsvla.compiler.variants.solids import link_frames
 from fsvla.compiler.variants.start import START_SLACK

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fsvla.compiler.collision import min_distance, pieces_of, pose_matrix
-from fsvla.compiler.placement import quat_yaw
+from fsvla.compiler.collision import min_distance, pieces_of
+from fsvla.compiler.pose import pose_matrix, quat_yaw
 from fsvla.compiler.scene import LoweringError, SceneBody, SceneSpec
 from fsvla.compiler.variants import (
     CLUTTER_CLEARANCE,
@@ -28,7 +28,7 @@ from fsvla.compiler.variants import (
     rules_of,
 )
 from fsvla.dsl.loader import ScenarioLoader
-from fsvla.dsl.models import Approach, Clutter, Scenario
+from fsvla.dsl.models import Clutter, Scenario
 from fsvla.dsl.render import render_full
 from rich.console import Console
 

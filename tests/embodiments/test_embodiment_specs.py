@@ -20,7 +20,6 @@ from fsvla.embodiments import (
     builtin_embodiments,
     load_embodiment,
 )
-from fsvla.embodiments.frames import look_at_quat, quat_to_matrix, yaw_quat
 
 BUILTINS = ("baxter", "dual_panda", "panda", "so101", "z1")
 
@@ -166,15 +165,6 @@ def test_duplicate_arm_names_are_rejected() -> None:
     data = _user_data()
     data["robots"].append({**data["robots"][0], "name": "other"})
     assert "arm `arm` is listed twice" in _errors(data)
-
-
-def test_frames_conventions() -> None:
-    # yaw: wxyz quaternion about +z
-    assert np.allclose(quat_to_matrix(yaw_quat(np.pi / 2)) @ [1, 0, 0], [0, 1, 0], atol=1e-9)
-    # a SAPIEN camera looks along its local +x, with +z up
-    rot = quat_to_matrix(look_at_quat((1.0, 0.0, 1.0), (0.0, 0.0, 0.0)))
-    assert np.allclose(rot[:, 0], np.array([-1.0, 0.0, -1.0]) / np.sqrt(2))
-    assert rot[2, 2] > 0
 
 
 def test_importing_fsvla_does_not_import_sapien() -> None:

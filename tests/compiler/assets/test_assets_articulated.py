@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from fsvla.compiler.assets import build_asset
 from fsvla.compiler.assets.articulated import TEMPLATE_DIR, render_urdf
-from fsvla.compiler.assets.geometry import pose_matrix, quat_from_axis_angle, quat_to_matrix
 from fsvla.compiler.assets.urdf import UrdfError, parse_urdf
+from fsvla.compiler.pose import axis_angle_matrix, pose_matrix
 
 EXPECTED = {  # kind -> (part, joint type, lower, upper)
     "drawer_cabinet": ("drawer", "prismatic", 0.0, 0.2),
@@ -65,7 +65,7 @@ def _part_centre(asset, part_name, q):
     if joint.type == "prismatic":
         motion[:3, 3] = np.asarray(joint.axis) * q
     else:
-        motion[:3, :3] = quat_to_matrix(quat_from_axis_angle(joint.axis, q))
+        motion[:3, :3] = axis_angle_matrix(joint.axis, q)
     transform = pose_matrix(joint.origin) @ motion
     link = next(item for item in asset.links if item.name == part.link)
     centres = [transform @ np.r_[s.pose.position, 1.0] for s in link.collision]
