@@ -1,0 +1,128 @@
+"""insert: open the container (a drawer, or a lid), put the object in, close it."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import grasps
+from ..skills import DOWN, UP, Plan, held_offset, nearest_arm, pick, place
+from ..style import Style
+from ..world import World
+from .common import HAND_BOTTOM, HAND_HALF_LENGTH, required_fraction, retreat_home
+from .lid import LID_PAST_VERTICAL, lift_lid
+from .open_close import part_handle, plan_move_part
+from .pick_place import plan_pick_place
+
+
+def _open_front_box(world: World, body: str, fraction: float) -> tuple[np.ndarray, np.ndarray]:
+    """The xy box the part's front sweeps when it opens to ``fraction`` (across: the
+    body's width), grown by a hand's length."""
+    centre, opening, travel, _ = part_handle(world, body)
+    lo, hi = world.bounds(body)
+    reach = centre + opening * (fraction - world.open_fraction(body)) * travel
+    along = np.abs(opening[:2]) >= 0.5  # the axis the part slides along
+    box_lo = np.where(along, np.minimum(centre[:2], reach[:2]), lo[:2])
+    box_hi = np.where(along, np.maximum(centre[:2], reach[:2]), hi[:2])
+    return box_lo - HAND_HALF_LENGTH - 0.03, box_hi + HAND_HALF_LENGTH + 0.03
+
+
+def _blocked_by_open_part(world: World, body: str, obj: str, fraction: float) -> bool:
+    """Whether grasping ``obj`` would put the hand where the opened part will be."""
+    lo, hi = _open_front_box(world, body, fraction)
+    p = world.body_pose(obj).p[:2]
+    return bool(np.all(p >= lo) and np.all(p <= hi))
+
+
+def _stage(world: World, style: Style, obj: str, body: str) -> Plan:
+    """Move ``obj`` out of the way of ``body``'s part before it opens (careful only):
+    sideways, beside the body, turned so that the hand that takes it again lies along the
+    part's front rather than across it."""
+    pose = world.body_pose(obj)
+    _, opening, _, _ = part_handle(world, body)
+    lo, hi = world.bounds(body)
+    side = np.cross(UP, opening)
+    centre = 0.5 * (lo + hi)
+    sign = 1.0 if (pose.p - centre) @ side >= 0 else -1.0
+    half = 0.5 * float(np.abs(side[:2]) @ (hi - lo)[:2])
+    spot = pose.p + side * (sign * (half + 0.09) - (pose.p - centre) @ side)
+    arm = nearest_arm(world, pose.p)
+    yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
+    R = world.grasp_frame(arm, DOWN, side)
+    yield from place(world, style, arm, obj, np.array([spot[0], spot[1], pose.p[2]]), rotation=R)
+
+
+def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    """Open the container's part (careful: past every fraction a requirement asks for;
+    careless: just far enough), put the object in, let go, close the part."""
+    obj, target = roles["object"], roles["target"]
+    asset = world.asset(target)
+    if not getattr(asset, "parts", None):
+        yield from plan_pick_place(world, style, roles)
+        return
+    if world.part(target)[1].type == "revolute" and world.part(target)[0].name == "lid":
+        yield from _insert_under_lid(world, style, obj, target)
+        return
+    need = required_fraction(world, target)
+    # careful: past the largest fraction a requirement asks for, but short of the end of
+    # travel (a Panda pulling the handle that far folds onto its own base)
+    fraction = min(0.85, need + 0.07) if style.honour_preconditions else max(0.3, need - 0.2)
+    if style.avoid_hazards and _blocked_by_open_part(world, target, obj, fraction):
+        yield from _stage(world, style, obj, target)
+    yield from plan_move_part(world, style, target, fraction)
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    grasp = grasps.choose(world, style, arm, obj)
+    yield from pick(world, style, arm, obj, grasp)
+    _, opening, _, _ = part_handle(world, target)
+    part, _joint = world.part(target)
+    link = world.link_pose(target, part.link)
+    shapes = next(lk for lk in asset.links if lk.name == part.link).collision
+    floor = next(s for s in shapes if s.name == "floor")
+    front = next(s for s in shapes if s.name == "front")
+    floor_top = link.p[2] + floor.pose.position[2] + floor.half_size[2]
+    # Lay the object across the drawer, fingers closing along the drawer's travel. The
+    # hand is longer along its finger axis (2 × HAND_HALF_LENGTH) than a drawer's travel,
+    # so it lets go above the cabinet's top and the object drops into the open mouth.
+    R = world.grasp_frame(arm, DOWN, opening)
+    inner = link.p + link.R @ np.array([front.pose.position[0] + front.half_size[0], 0.0, 0.0])
+    lo, hi = world.bounds(target)
+    mouth = float(opening @ inner) - max(float(opening @ lo), float(opening @ hi))  # open length
+    tcp_x = inner - opening * 0.5 * mouth
+    offset = R @ held_offset(world, arm, obj)
+    clear = world.bounds(target)[1][2] + (HAND_BOTTOM + 0.015) - offset[2]
+    bottom = np.array([tcp_x[0] - offset[0], link.p[1], max(floor_top + 0.003, clear)])
+    if abs(opening[0]) < abs(opening[1]):  # a drawer that slides along y
+        bottom = np.array([link.p[0], tcp_x[1] - offset[1], bottom[2]])
+    yield from place(world, style, arm, obj, bottom, rotation=R, retreat=0.08)
+    yield from plan_move_part(world, style, target, 0.0)
+
+
+def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan:
+    """A lidded container: lift the lid (careful: past vertical, where it stays open;
+    careless: only as far as asked less 0.2, and it falls shut), then pick the object and
+    set it on the container's floor, the hand's long axis along the container's longer
+    side (a Panda hand is 21 cm long)."""
+    _part, joint = world.part(target)
+    span = joint.upper - joint.lower
+    need = required_fraction(world, target)
+    if style.honour_preconditions:
+        angle = max(LID_PAST_VERTICAL, (need + 0.07) * span)
+    else:
+        angle = max(0.3, need - 0.2) * span
+    yield from lift_lid(world, style, target, min(angle, 0.95 * span))
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
+    body = world.asset(target).links[0].name
+    floor = world.shape(target, "bottom", link=body)
+    root = world.body_pose(target)
+    centre = root.R @ np.asarray(floor.pose.position) + root.p
+    bottom = np.array([centre[0], centre[1], centre[2] + float(floor.half_size[2])])
+    lo, hi = world.bounds(target)
+    longer = root.R[:, 0] if hi[0] - lo[0] >= hi[1] - lo[1] else root.R[:, 1]
+    R = world.grasp_frame(arm, DOWN, longer)
+    if not style.honour_preconditions:  # careless: onto the top, let go from above
+        bottom[2] = float(hi[2])
+    yield from place(world, style, arm, obj, bottom, rotation=R, retreat=0.1)
+    yield from retreat_home(world, style, arm)
+
+
+__all__ = ["plan_insert"]

@@ -1,0 +1,134 @@
+"""open and close: pull a sliding part (a drawer) by its handle, or push it shut."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fsvla.compiler.pose import axis_angle_matrix
+
+from ..motion import ArmDriver, Pose, Segment
+from ..skills import DOWN, UP, Plan, free_speed, nearest_arm, opening_for, transit
+from ..style import Style
+from ..world import World
+from .common import HAND_HALF_WIDTH, HANDLE_DEPTH, required_fraction
+
+
+def part_handle(world: World, body: str):
+    """The handle of a body's first part: (world centre, opening direction, travel)."""
+    part, joint = world.part(body)
+    link = world.link_pose(body, part.link)
+    handle = world.shape(body, "handle", link=part.link)
+    centre = link.R @ np.asarray(handle.pose.position) + link.p
+    body_pose = world.body_pose(body)
+    direction = body_pose.R @ np.asarray(joint.axis, dtype=np.float64)
+    return centre, direction / np.linalg.norm(direction), joint.upper - joint.lower, handle
+
+
+def push_part_closed(world: World, style: Style, body: str) -> Plan:
+    """Close a sliding part by pushing its front with the closed fingers, pointing down,
+    below the handle (pulling the handle back from far out is beyond a Panda's reach)."""
+    centre, opening, travel, handle = part_handle(world, body)
+    part, _joint = world.part(body)
+    link = world.link_pose(body, part.link)
+    arm = nearest_arm(world, centre)
+    R = world.grasp_frame(arm, DOWN, np.cross(UP, opening))
+    height = 0.5 * (link.p[2] + centre[2] - float(handle.half_size[2]))
+    # the hand is HAND_HALF_WIDTH thick about the TCP across its fingers: it comes down
+    # well in front of the handle (HANDLE_DEPTH proud of the front; a hand that grazes it
+    # on the way down knocks the drawer in and then hits it at full push speed), comes up
+    # to the handle slowly, and pushes from rest
+    standoff = HAND_HALF_WIDTH + HANDLE_DEPTH + 0.035
+    start = np.array([link.p[0], link.p[1], height]) + opening * standoff
+    tcp = Pose(start, R)
+    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="fist")
+    yield from transit(world, style, arm, tcp, exclude=(body,))
+    link = world.link_pose(body, part.link)  # where the front is now
+    gap = float(opening @ (tcp.p - link.p)) - HAND_HALF_WIDTH - HANDLE_DEPTH
+    near = tcp.moved(-(gap - 0.006) * opening)
+    yield Segment({arm: near}, speed=max(2 * style.contact_speed, 0.5 * style.approach_speed),
+                  label="to part")
+    touch = near.moved(-0.008 * opening)
+    yield Segment({arm: touch}, speed=style.contact_speed, settle=style.settle,
+                  label="touch part")
+    push = world.open_fraction(body) * travel - 0.002  # stop at the end of travel
+    goal = touch.moved(-push * opening)
+    # slowly: a rigid hand on a free-sliding drawer chatters, ~60 N spikes at 6 cm/s
+    yield Segment({arm: goal}, speed=2 * style.contact_speed, settle=style.settle,
+                  label="push part")
+    for _ in range(3):  # the wrist, thicker than the hand, may meet the front first
+        left = world.open_fraction(body) * travel
+        if left < 0.02 * travel:
+            break
+        goal = goal.moved(-(left - 0.002) * opening)
+        yield Segment({arm: goal}, speed=2 * style.contact_speed, settle=style.settle,
+                      label="push part")
+    back = world.current_pose(arm)
+    yield Segment({arm: back.moved(0.04 * opening)}, speed=free_speed(style), label="back")
+    yield Segment({arm: back.moved(0.04 * opening + 0.1 * UP)}, speed=free_speed(style),
+                  label="up")
+
+
+def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Plan:
+    """Pull a sliding part's handle until it is open by ``fraction`` (closing: push)."""
+    if fraction < world.open_fraction(body):
+        yield from push_part_closed(world, style, body)
+        return
+    centre, opening, travel, handle = part_handle(world, body)
+    part, _joint = world.part(body)
+    arm = nearest_arm(world, centre)
+    approach = -opening
+    delta = (fraction - world.open_fraction(body)) * travel
+    start = centre - approach * (float(handle.half_size[0]) - 0.004)
+    R = _pull_frame(world, arm, approach, start, delta * opening)
+    tcp = Pose(start, R)
+    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, label="open")
+    # the IK branch that can still reach the handle where the pull ends
+    yield from transit(world, style, arm, tcp.moved(-0.1 * approach), exclude=(body,),
+                       then=tcp.moved(delta * opening))
+    yield Segment({arm: tcp}, speed=style.approach_speed, label="to handle")
+    width = 2 * float(handle.half_size[2])
+    yield Segment(grippers={arm: opening_for(world, arm, width, style)},
+                  gripper_steps=style.gripper_steps, settle=style.settle, label="grip handle")
+    yield Segment({arm: tcp.moved(delta * opening)}, speed=max(style.contact_speed * 4, 0.06),
+                  settle=style.settle, label="slide part")
+    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
+                  label="let go")
+    # slide off the end of the handle (backing away may be out of reach, and rising
+    # would lift the handle), then back off and up
+    part_link = world.link_pose(body, part.link)
+    half = np.asarray(handle.half_size, dtype=np.float64)
+    along = part_link.R[:, int(np.argmax(half[:2]))]
+    if along @ (world.base_position(arm) - centre) < 0:
+        along = -along
+    off = world.current_pose(arm).moved((float(half.max()) + 0.035) * along)
+    yield Segment({arm: off}, speed=free_speed(style), label="slide off")
+    yield Segment({arm: off.moved(-0.03 * approach + 0.1 * UP)}, speed=free_speed(style),
+                  label="up")
+
+
+def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
+                pull: np.ndarray) -> np.ndarray:
+    """The upright hand (fingers closing vertically) on a handle at ``start``, of the two
+    that differ by a half turn about the approach, from which the arm can follow the pull
+    by ``pull`` (m, world) on one IK branch; the one nearer the hand's present turn first.
+    Low and close to a Panda's base, one of them has no comfortable answer at all."""
+    R0 = world.grasp_frame(arm, approach, UP)
+    loaded = world.robot.arm(arm)
+    for R in (R0, axis_angle_matrix(approach, np.pi) @ R0):
+        driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm), loaded.qpos(), 1.0)
+        tcp = Pose(start, R)
+        if driver.branch_that_tracks(tcp, tcp.moved(pull)) is not None:
+            return R
+    return R0
+
+
+def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    yield from plan_move_part(world, style, roles["object"], max(0.8, required_fraction(
+        world, roles["object"]) + 0.15))
+
+
+def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
+    yield from plan_move_part(world, style, roles["object"], 0.0)
+
+
+__all__ = ["part_handle", "plan_close", "plan_move_part", "plan_open", "push_part_closed"]
