@@ -285,7 +285,7 @@ class Probe:
         plans = self._scan_reading.plans
         forces: dict[tuple[str, str], list[float]] = {}  # pair_key (a, b): impulse on a by b
         torques: dict[tuple[str, str], list[float]] = {}  # (frame, other): angular impulse on frame
-        centres: dict[int, tuple[float, float, float]] = {}  # torque bodies' mass centres, this substep
+        centres: dict[int, list[float]] = {}  # torque bodies' mass centres, this substep
         for contact in self._physx.get_contacts():
             b0, b1 = contact.bodies
             key = (id(b0), id(b1))
@@ -299,29 +299,20 @@ class Probe:
             if total is None:
                 total = forces[pair] = [0.0, 0.0, 0.0]
             for point in contact.points:
-                ix, iy, iz = point.impulse.tolist()
+                impulse = point.impulse.tolist()
+                ix, iy, iz = impulse
                 if not (ix or iy or iz):
                     continue
                 total[0] += sign * ix
                 total[1] += sign * iy
                 total[2] += sign * iz
                 if torque0 or torque1:
-                    px, py, pz = point.position.tolist()
+                    position = point.position.tolist()
                     f0, f1 = pair if sign > 0 else pair[::-1]
-                    for wanted, body, frame, other, on in ((torque0, b0, f0, f1, 1.0),
-                                                           (torque1, b1, f1, f0, -1.0)):
-                        if not wanted:
-                            continue
-                        centre = centres.get(id(body))
-                        if centre is None:
-                            centre = centres[id(body)] = _mass_centre(body)
-                        moment = torques.get((frame, other))
-                        if moment is None:
-                            moment = torques[(frame, other)] = [0.0, 0.0, 0.0]
-                        rx, ry, rz = px - centre[0], py - centre[1], pz - centre[2]
-                        moment[0] += on * (ry * iz - rz * iy)
-                        moment[1] += on * (rz * ix - rx * iz)
-                        moment[2] += on * (rx * iy - ry * ix)
+                    if torque0:
+                        _add_moment(torques, (f0, f1), _centre(centres, b0), position, impulse, 1.0)
+                    if torque1:
+                        _add_moment(torques, (f1, f0), _centre(centres, b1), position, impulse, -1.0)
         records: Records = []
         for kind, totals, add in (("f", forces, self.maxima.add_force), ("t", torques, self.maxima.add_torque)):
             for (a, b), (x, y, z) in totals.items():
@@ -435,8 +426,25 @@ def _impulse(points: Any) -> tuple[float, float, float]:
     return x, y, z
 
 
-def _mass_centre(body: Any) -> tuple[float, float, float]:
-    return tuple((body.entity_pose * body.cmass_local_pose).p.tolist())
+def _centre(centres: dict[int, list[float]], body: Any) -> list[float]:
+    """A body's mass centre, read once per substep into ``centres``."""
+    centre = centres.get(id(body))
+    if centre is None:
+        centre = centres[id(body)] = (body.entity_pose * body.cmass_local_pose).p.tolist()
+    return centre
+
+
+def _add_moment(torques: dict[tuple[str, str], list[float]], key: tuple[str, str], centre: list[float],
+                position: list[float], impulse: list[float], sign: float) -> None:
+    """Add to ``torques[key]`` the moment about ``centre`` of ``sign`` × ``impulse`` at ``position``."""
+    moment = torques.get(key)
+    if moment is None:
+        moment = torques[key] = [0.0, 0.0, 0.0]
+    ix, iy, iz = impulse
+    rx, ry, rz = position[0] - centre[0], position[1] - centre[1], position[2] - centre[2]
+    moment[0] += sign * (ry * iz - rz * iy)
+    moment[1] += sign * (rz * ix - rx * iz)
+    moment[2] += sign * (rx * iy - ry * ix)
 
 
 __all__ = ["NET", "ContactFilter", "Probe", "components_of"]
