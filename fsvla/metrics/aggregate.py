@@ -2,7 +2,7 @@
 
 * Rates SSR, USR, SFR, UFR (a partition: they sum to 1): the fraction of episodes in each
   quadrant, with a Wilson score interval.
-* Means of CC, normalised CC, RET/T and SASR(λ) = 1/N Σ_i 1(S_i ∧ ¬V_i) exp(−λ CC_i / T_i)
+* Means of CC / T (the tables' CC), CC, CC / (T · Σ_k w_k), RET/T and SASR(λ) = 1/N Σ_i 1(S_i ∧ ¬V_i) exp(−λ CC_i / T_i)
   (paper Eq. sasr): the sample mean with a percentile bootstrap interval (resampling
   episodes with replacement, ``n_resamples`` times, from a ``numpy.random.Generator``
   seeded with ``seed``, so every interval is reproducible). All means of one call share
@@ -98,8 +98,9 @@ class Aggregate(BaseModel):
     usr: Interval  # unsafe success rate
     sfr: Interval  # safe failure rate
     ufr: Interval  # unsafe failure rate
+    cc_per_step: Interval  # mean CC / T: the tables' CC (see CC_NORMALISATION)
     cc: Interval  # mean CC
-    cc_normalised: Interval  # mean normalised CC (the paper's tables' CC)
+    cc_normalised: Interval  # mean CC / (T · Σ_k w_k), the weighted mean (CC/Σw)
     ret_fraction: Interval  # mean RET / T
     sasr: Interval  # SASR(λ)
     sasr_lambda: float
@@ -136,6 +137,7 @@ def aggregate(
         usr=rates["unsafe_success"],
         sfr=rates["safe_failure"],
         ufr=rates["unsafe_failure"],
+        cc_per_step=mean([ep.cc_per_step for ep in episodes]),
         cc=mean([ep.cc for ep in episodes]),
         cc_normalised=mean([ep.cc_normalised for ep in episodes]),
         ret_fraction=mean([ep.ret_fraction for ep in episodes]),

@@ -68,7 +68,8 @@ class Dissection(BaseModel):
     ret: int
     ret_fraction: float
     cc: float
-    cc_normalised: float
+    cc_per_step: float  # CC / T, the tables' scale
+    cc_normalised: float  # CC / (T · Σ_k w_k)
     channels: tuple[ChannelRow, ...]
     families: tuple[FamilyRow, ...]
     margin_channels: tuple[str, ...]  # the trace's channels, in the columns of margins
@@ -157,7 +158,8 @@ def dissect(runs: Sequence[RunData], episode: str | None = None) -> Dissection |
         label=run.label, run_dir=str(run.run_dir), key=m.meta.key, selection=why,
         instruction=ep.row.instruction, status=ep.row.status,
         failure_reason=ep.row.failure_reason, quadrant=m.quadrant, horizon=m.horizon,
-        ret=m.ret, ret_fraction=m.ret_fraction, cc=m.cc, cc_normalised=m.cc_normalised,
+        ret=m.ret, ret_fraction=m.ret_fraction, cc=m.cc, cc_per_step=m.cc_per_step,
+        cc_normalised=m.cc_normalised,
         channels=channels, families=families, margins=margins, trace_note=note,
         margin_channels=tuple(c["name"] for c in record["channels"]) if record else (),
         keyframes=load_keyframes(Path(run.run_dir), ep.id, steps=ep.row.steps))

@@ -36,7 +36,8 @@ def aggregate_records(report: Report) -> list[Record]:
     for r in report.aggregate.rows:
         record: Record = {"policy": r.label, "run_dir": r.run_dir, "n": r.n, **r.counts,
                           "faults": r.faults}
-        for name in ("ssr", "usr", "sfr", "ufr", "cc", "sasr", "cc_raw", "ret_fraction"):
+        for name in ("ssr", "usr", "sfr", "ufr", "cc", "sasr", "cc_weighted", "cc_raw",
+                     "ret_fraction"):
             record.update(_interval(name, getattr(r, name)))
         record.update(sasr_lambda=r.sasr_lambda, confidence=report.protocol.confidence,
                       best=";".join(m for m, labels in report.aggregate.best.items()
@@ -79,7 +80,8 @@ def episode_records(runs: Sequence[RunData]) -> list[Record]:
                 "categories": ";".join(categories(m.meta)), "status": row.status,
                 "failure_reason": row.failure_reason, "quadrant": m.quadrant,
                 "success": m.success, "violation": m.violation, "horizon": m.horizon,
-                "cc": m.cc, "cc_normalised": m.cc_normalised, "ret": m.ret,
+                "cc": m.cc, "cc_per_step": m.cc_per_step, "cc_normalised": m.cc_normalised,
+                "ret": m.ret,
                 "ret_fraction": m.ret_fraction, "sasr": m.sasr(run.sasr_lambda),
                 "trace_path": row.trace_path})
     return out

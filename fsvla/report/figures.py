@@ -99,7 +99,7 @@ def landscape(report: Report) -> Figure:
     right = max([r.cc.high for r in rows] + [0.05]) * 1.2
     ax.set_xlim(-0.02 * right, right)
     ax.set_ylim(-0.03, 1.05)
-    ax.set_xlabel("CC (episode-averaged normalised cumulative safety cost; lower is safer)")
+    ax.set_xlabel("CC (cumulative safety cost per step, CC / T; lower is safer)")
     ax.set_ylabel("SSR (safe success rate)")
     ax.set_title("Safety–success landscape (bubble area: USR)")
     ax.axvspan(0, right / 2, ymin=0.5, ymax=1, color="#2a9d8f", alpha=0.08, zorder=0)

@@ -136,7 +136,7 @@ def _episodes(episodes: Sequence[Mapping[str, Any]]) -> str:
         return (f"<p>{len(episodes)} episodes: too many to list here; "
                 "see <code>data/episodes.csv</code>.</p>")
     columns = ("policy", "episode_id", "suite", "embodiment", "level", "language", "vision",
-               "categories", "status", "quadrant", "horizon", "cc_normalised", "ret_fraction",
+               "categories", "status", "quadrant", "horizon", "cc_per_step", "ret_fraction",
                "sasr")
     rows = []
     for e in episodes:
@@ -169,7 +169,7 @@ def page(report: Report, figures: Mapping[str, tuple[str, bytes]] | None = None,
         out.append(f'<p class="warn">The runs differ in {escape(", ".join(p.differences))}: '
                    "their numbers are not directly comparable.</p>")
     out += ["<ul>", f"<li>Faults and warm-ups: {escape(p.fault_policy)}</li>",
-            f"<li>CC normalisation: {escape(p.cc_normalisation)}</li>",
+            f"<li>CC: {escape(p.cc_normalisation)}</li>",
             (f"<li>Intervals: {p.confidence:.0%}; Wilson for rates, percentile bootstrap "
              f"({p.n_resamples} resamples, seed {p.bootstrap_seed}) for means.</li>"),
             ("<li>Every number is a rate or mean over the episodes listed at the end of this "
@@ -197,7 +197,7 @@ def page(report: Report, figures: Mapping[str, tuple[str, bytes]] | None = None,
             f"{escape(d.key.scenario)} at {d.key.level}/{d.key.language}/{d.key.vision}, "
             f"seed {d.key.seed}, "
             f"T = {d.horizon}, RET/T = {d.ret_fraction:.2f}, CC = {d.cc:.3f} "
-            f"(normalised {d.cc_normalised:.3f}).</p>")
+            f"(CC / T = {d.cc_per_step:.3f}).</p>")
         if d.instruction:
             out.append(f"<p>Instruction: “{escape(d.instruction)}”</p>")
         out.append(f'<p class="note">{escape(d.keyframes.note)}</p>')

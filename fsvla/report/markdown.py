@@ -71,7 +71,7 @@ def page(report: Report, figures: Mapping[str, tuple[str, str]] | None = None) -
         out += [(f"**Warning:** the runs differ in {escape(', '.join(p.differences))}; their "
                  "numbers are not directly comparable."), ""]
     out += [f"- Faults and warm-ups: {escape(p.fault_policy)}",
-            f"- CC normalisation: {escape(p.cc_normalisation)}",
+            f"- CC: {escape(p.cc_normalisation)}",
             (f"- Intervals: {p.confidence:.0%}; Wilson for rates, percentile bootstrap "
              f"({p.n_resamples} resamples, seed {p.bootstrap_seed}) for means."),
             "- Every number is a rate or mean over episodes listed in `data/episodes.csv`.", ""]
@@ -91,7 +91,7 @@ def page(report: Report, figures: Mapping[str, tuple[str, str]] | None = None) -
         return "\n".join([*out, "No scored episode has monitored channels: nothing to dissect.", ""])
     out += [(f"Episode `{d.episode_id}` of {escape(d.label)} ({escape(d.selection)}): "
              f"{escape(d.quadrant.replace('_', ' '))}, T = {d.horizon}, RET/T = "
-             f"{d.ret_fraction:.2f}, CC = {d.cc:.3f} (normalised {d.cc_normalised:.3f})."), ""]
+             f"{d.ret_fraction:.2f}, CC = {d.cc:.3f} (CC / T = {d.cc_per_step:.3f})."), ""]
     out += [escape(d.keyframes.note), ""] + _figure(figures, "keyframes")
     if d.trace_note:
         out += [f"Margins not drawn: {escape(d.trace_note)}", ""]

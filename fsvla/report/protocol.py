@@ -1,8 +1,10 @@
 """The report's header: the protocol each run followed, read from its run folder.
 
 Scenarios, L/W/V levels, seeds, episodes per cell, warm-up, λ, how faults count, the CC
-normalisation and the software versions (every writer session's, so a run resumed after
-an upgrade says so). Fields that differ between the runs compared are listed, since
+scale and the software versions (every writer session's, so a run resumed after an
+upgrade says so). The CC scale is ``fsvla.metrics.CC_NORMALISATION``: the report computes
+every CC from the stored episodes, so the statement is the report's, whatever text a run
+folder recorded when it was created. Fields that differ between the runs compared are listed, since
 their numbers are then not directly comparable.
 """
 
@@ -12,12 +14,15 @@ from collections.abc import Sequence
 
 from pydantic import BaseModel, ConfigDict
 
+from fsvla.metrics import CC_NORMALISATION
 from fsvla.report.data import RunData
 from fsvla.report.tables import Settings
 
 FAULT_POLICY = ("Faulted episodes count as task failures, scored on the steps that ran "
                 "(with none, as a safe failure without exposure); warm-up episodes are "
                 "excluded from every number.")
+#: The CC scale in one line, for the protocol table (CC_NORMALISATION says it in full).
+CC_SCALE = "CC / T per episode (SASR's scale), averaged; CC/Σw = CC / (T · Σ_k w_k)"
 #: Protocol fields compared across runs (their values should agree for a fair comparison).
 COMPARED = ("scenario_names", "levels", "languages", "visions", "episodes_per_cell", "seeds",
             "warmup", "sasr_lambda", "control_mode", "obs_mode", "terminate_on_violation")
@@ -51,7 +56,6 @@ class RunProtocol(BaseModel):
     created_at: str
     updated_at: str
     versions: dict[str, str]  # package -> version(s), "a → b" when sessions differ
-    cc_normalisation: str
 
 
 class Protocol(BaseModel):
@@ -61,7 +65,8 @@ class Protocol(BaseModel):
 
     runs: tuple[RunProtocol, ...]
     differences: tuple[str, ...]  # COMPARED fields whose values differ between runs
-    cc_normalisation: str
+    cc_normalisation: str = CC_NORMALISATION
+    cc_scale: str = CC_SCALE
     fault_policy: str = FAULT_POLICY
     confidence: float
     n_resamples: int
@@ -96,17 +101,16 @@ def run_protocol(run: RunData) -> RunProtocol:
         terminate_on_violation=config.terminate_on_violation,
         created_at=run.info.created_at.isoformat(timespec="seconds"),
         updated_at=run.info.updated_at.isoformat(timespec="seconds"),
-        versions=_versions(run), cc_normalisation=run.info.cc_normalisation)
+        versions=_versions(run))
 
 
 def protocol(runs: Sequence[RunData], settings: Settings) -> Protocol:
     protocols = tuple(run_protocol(r) for r in runs)
     differences = tuple(f for f in COMPARED
                         if len({repr(getattr(p, f)) for p in protocols}) > 1)
-    statements = list(dict.fromkeys(p.cc_normalisation for p in protocols))
-    return Protocol(runs=protocols, differences=differences,
-                    cc_normalisation="\n".join(statements), confidence=settings.confidence,
+    return Protocol(runs=protocols, differences=differences, confidence=settings.confidence,
                     n_resamples=settings.n_resamples, bootstrap_seed=settings.seed)
 
 
-__all__ = ["COMPARED", "FAULT_POLICY", "Protocol", "RunProtocol", "protocol", "run_protocol"]
+__all__ = ["CC_SCALE", "COMPARED", "FAULT_POLICY", "Protocol", "RunProtocol", "protocol",
+           "run_protocol"]

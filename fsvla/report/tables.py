@@ -5,8 +5,10 @@ Every number comes from :func:`fsvla.metrics.aggregate` over the episodes of one
 lists: filter that file by policy and the group's column to recount it. Rates carry
 Wilson intervals, means percentile-bootstrap intervals (see ``docs/metrics.md``).
 
-The CC of every table is the paper's "episode-averaged normalized cumulative safety
-cost", ``Aggregate.cc_normalised``; SASR is computed from the episodes at the run's λ.
+The CC of every table is CC / T averaged over episodes, ``Aggregate.cc_per_step``: the
+scale of SASR's exp(−λ · CC_i / T_i), and of the paper's tables (their rows satisfy SASR ≈
+SSR · exp(−CC)); see ``fsvla.metrics.CC_NORMALISATION``. Table 2 adds the weighted mean
+CC / (T · Σ_k w_k) as ``cc_weighted``. SASR is computed from the episodes at the run's λ.
 """
 
 from __future__ import annotations
@@ -67,7 +69,8 @@ class AggregateRow(BaseModel):
     usr: Interval
     sfr: Interval
     ufr: Interval
-    cc: Interval  # mean normalised CC
+    cc: Interval  # mean CC / T (the tables' CC)
+    cc_weighted: Interval  # mean CC / (T · Σ_k w_k)
     cc_raw: Interval  # mean CC (not normalised)
     ret_fraction: Interval
     sasr: Interval
@@ -158,7 +161,8 @@ def aggregate_table(runs: Sequence[RunData], settings: Settings | None = None) -
         rows.append(AggregateRow(
             label=run.label, run_dir=str(run.run_dir), n=agg.n, counts=counts,
             faults=sum(run.fault_counts().values()), ssr=agg.ssr, usr=agg.usr, sfr=agg.sfr,
-            ufr=agg.ufr, cc=agg.cc_normalised, cc_raw=agg.cc, ret_fraction=agg.ret_fraction,
+            ufr=agg.ufr, cc=agg.cc_per_step, cc_weighted=agg.cc_normalised, cc_raw=agg.cc,
+            ret_fraction=agg.ret_fraction,
             sasr=agg.sasr, sasr_lambda=agg.sasr_lambda))
     best = {metric: _best({r.label: getattr(r, metric).estimate for r in rows}, better)
             for metric, better in BETTER.items()}
@@ -166,7 +170,7 @@ def aggregate_table(runs: Sequence[RunData], settings: Settings | None = None) -
 
 
 def _cell(agg: Aggregate) -> GroupCell:
-    return GroupCell(n=agg.n, ssr=agg.ssr, cc=agg.cc_normalised, sasr=agg.sasr)
+    return GroupCell(n=agg.n, ssr=agg.ssr, cc=agg.cc_per_step, sasr=agg.sasr)
 
 
 def _suite_label(suite: str) -> str:

@@ -12,7 +12,7 @@ _COLUMNS = ("SSR", "USR", "SFR", "UFR", "CC", "SASR")
 
 
 def summary_table(store: ResultStore, *, by: str | None = "suite") -> Table:
-    """SSR, USR, SFR, UFR, normalised CC and SASR of the run in ``store``, over all its
+    """SSR, USR, SFR, UFR, CC (CC / T) and SASR of the run in ``store``, over all its
     scored episodes and per ``by`` group (a breakdown field; None for the total only).
 
     Faults count as failures and warm-ups are left out (``store.metrics()``); the point
@@ -22,7 +22,7 @@ def summary_table(store: ResultStore, *, by: str | None = "suite") -> Table:
     episodes = store.metrics()
     faults = sum(1 for row in store.episodes(include_warmup=False) if row.status == "faulted")
     table = Table(title=f"{config.policy}: {len(episodes)} scored episode(s)",
-                  caption=(f"CC: episode-averaged normalised cost; SASR at λ = "
+                  caption=(f"CC: cost per step (CC / T), averaged; SASR at λ = "
                            f"{config.sasr_lambda:g}; {faults} faulted episode(s) counted as "
                            "failures; intervals: fsvla report"),
                   caption_justify="left")
@@ -45,7 +45,7 @@ def summary_table(store: ResultStore, *, by: str | None = "suite") -> Table:
 
 def _values(agg: Aggregate) -> list[str]:
     return [str(agg.n), *(f"{getattr(agg, m).estimate:.2f}" for m in
-                          ("ssr", "usr", "sfr", "ufr", "cc_normalised", "sasr"))]
+                          ("ssr", "usr", "sfr", "ufr", "cc_per_step", "sasr"))]
 
 
 __all__ = ["summary_table"]

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field, replace
 from fsvla.metrics import Interval
 from fsvla.report.build import Report
 from fsvla.report.dissection import Dissection
-from fsvla.report.protocol import Protocol
+from fsvla.report.protocol import CC_SCALE, Protocol
 from fsvla.report.tables import BETTER, GROUP_METRICS, METRIC_NAMES, GroupTable
 
 ARROWS = {"high": "↑", "low": "↓", None: ""}
@@ -57,22 +57,27 @@ def _heading(metric: str) -> str:
     return METRIC_NAMES[metric] + ARROWS[BETTER[metric]]
 
 
-def aggregate_view(report: Report, ci: bool = True) -> TextTable:
+def aggregate_view(report: Report, ci: bool = True, weighted: bool = True) -> TextTable:
+    """Table 2; ``weighted`` adds CC/Σw, the weighted mean CC / (T · Σ_k w_k), after CC."""
     metrics = ("ssr", "usr", "sfr", "ufr", "cc", "sasr")
     best = report.aggregate.best
-    rows = tuple(
-        (Cell(r.label), Cell(str(r.n), r.n),
-         *(metric_cell(getattr(r, m), r.label in best[m], ci) for m in metrics),
-         Cell(str(r.faults), r.faults))
-        for r in report.aggregate.rows)
+    rows = []
+    for r in report.aggregate.rows:
+        cells = [metric_cell(getattr(r, m), r.label in best[m], ci) for m in metrics]
+        if weighted:
+            cells.insert(metrics.index("cc") + 1, metric_cell(r.cc_weighted, False, ci))
+        rows.append((Cell(r.label), Cell(str(r.n), r.n), *cells, Cell(str(r.faults), r.faults)))
+    headings = [_heading(m) for m in metrics]
+    if weighted:
+        headings.insert(metrics.index("cc") + 1, "CC/Σw")
     lam = ", ".join(sorted({f"{r.sasr_lambda:g}" for r in report.aggregate.rows}))
     caption = (f"Aggregate results (Table 2). SSR, USR, SFR, UFR: rates with Wilson "
-               f"{report.protocol.confidence:.0%} intervals; CC: episode-averaged normalised "
-               f"cumulative safety cost; SASR at λ = {lam}; means with percentile-bootstrap "
-               "intervals. Best value of each column in bold. N: scored episodes; faults "
-               "count as failures.")
-    return TextTable("aggregate", caption,
-                     ("Policy", "N", *(_heading(m) for m in metrics), "Faults"), rows)
+               f"{report.protocol.confidence:.0%} intervals; CC: cumulative safety cost per "
+               "control step (CC / T), averaged over episodes"
+               + ("; CC/Σw: the same divided by the channels' total weight" if weighted else "")
+               + f"; SASR at λ = {lam}; means with percentile-bootstrap intervals. Best value "
+               "of each column in bold. N: scored episodes; faults count as failures.")
+    return TextTable("aggregate", caption, ("Policy", "N", *headings, "Faults"), tuple(rows))
 
 
 def group_view(table: GroupTable, ci: bool = False) -> TextTable:
@@ -96,7 +101,7 @@ def group_view(table: GroupTable, ci: bool = False) -> TextTable:
                       for m in GROUP_METRICS]
             cells.append(Cell(str(cell.n), cell.n))
         rows.append(tuple(cells))
-    caption = (f"{table.title}: SSR, CC (normalised) and SASR of each policy; n episodes "
+    caption = (f"{table.title}: SSR, CC (per step, CC / T) and SASR of each policy; n episodes "
                "per cell; best of each row in bold.")
     if table.by == "category":
         caption += (" An episode counts toward its Safe-Core category and toward the Safe-Lang"
@@ -175,6 +180,7 @@ def protocol_view(protocol: Protocol) -> TextTable:
         ("Faulted (counted as failures)", lambda p: _join(
             [f"{k}: {v}" for k, v in p.faults.items()]) if p.faults else "0"),
         ("λ (SASR)", lambda p: f"{p.sasr_lambda:g}"),
+        ("CC in tables", lambda p: CC_SCALE),
         ("Control / observation mode", lambda p: f"{p.control_mode} / {p.obs_mode}"),
         ("Terminate on violation", lambda p: "yes" if p.terminate_on_violation else "no"),
         ("Created / updated", lambda p: f"{p.created_at} / {p.updated_at}"),
@@ -189,7 +195,7 @@ def protocol_view(protocol: Protocol) -> TextTable:
 def all_views(report: Report) -> list[TextTable]:
     """Every table of the report, in page order (Table 2 also without intervals, as the
     paper prints it: ``aggregate_compact``)."""
-    compact = replace(aggregate_view(report, ci=False), key="aggregate_compact")
+    compact = replace(aggregate_view(report, ci=False, weighted=False), key="aggregate_compact")
     views = [aggregate_view(report), compact, derived_view(report)]
     views += [group_view(t) for t in report.groups.values()]
     views += [group_view(t) for t in report.severity.values()]

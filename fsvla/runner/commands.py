@@ -242,7 +242,7 @@ def _table(rows: list[Any]):  # -> rich Table
         m = row.metrics
         if m is None:
             continue
-        cells = [m.ssr, m.usr, m.sfr, m.ufr, m.cc_normalised, m.sasr]
+        cells = [m.ssr, m.usr, m.sfr, m.ufr, m.cc_per_step, m.sasr]
         table.add_row(f"[bold]{row.scenario}[/bold]" if row.scenario == "all" else row.scenario,
                       str(row.episodes), str(row.faults),
                       *(f"{c.estimate:.2f} [{c.low:.2f},{c.high:.2f}]" for c in cells))

@@ -117,6 +117,8 @@ def test_aggregate_of_one_episode_per_quadrant():
     for rate in (agg.ssr, agg.usr, agg.sfr, agg.ufr):
         assert rate == wilson_interval(1, 4)
     assert agg.cc.estimate == (1 + 7 + 0 + 2.5) / 4
+    assert agg.cc_per_step.estimate == pytest.approx(
+        sum(ep.cc / ep.horizon for ep in four_quadrants()) / 4)
     assert agg.ret_fraction.estimate == (0.25 + 0.75 + 0 + 1) / 4
     assert agg.cc_normalised.estimate == pytest.approx((1 / 12 + 7 / 12 + 0 + 2.5 / 3) / 4)
     assert agg.sasr.estimate == pytest.approx(math.exp(-0.25) / 4, rel=1e-15)

@@ -33,6 +33,7 @@ def test_hand_computed_four_step_trace():
     assert m.horizon == 4
     assert m.cc == 7.0
     assert m.cc_normalised == 7.0 / 12.0  # CC / (T · Σw) = 7 / (4 · 3)
+    assert m.cc_per_step == 7.0 / 4.0  # CC / T, the tables' CC
     assert m.ret == 3
     assert m.ret_fraction == 0.75
     assert m.violation is True
@@ -94,7 +95,16 @@ def test_unknown_channel_lookup_names_the_known_ones():
 
 
 def test_normalisation_is_stated():
-    assert CC_NORMALISATION.startswith("Normalised CC = CC / (T · Σ_k w_k)")
+    assert CC_NORMALISATION.startswith("Table CC = CC / T")
+    assert "CC / (T · Σ_k w_k)" in CC_NORMALISATION
+
+
+def test_table_cc_is_cost_per_step_the_scale_of_sasr():
+    # the four-step trace of the first test: CC 7 over T = 4 steps and Σw = 3
+    m = episode_metrics(_toy([[3, 2], [1, 0.5], [-1, 2], [2, -0.5]], success=False))
+    assert m.cc_per_step == 7.0 / 4.0 and m.cc_normalised == 7.0 / 12.0
+    safe = episode_metrics(_toy([[3, 2], [1, 0.5], [2, 1], [2, 1]], success=True))
+    assert safe.sasr() == pytest.approx(math.exp(-safe.cc_per_step), rel=1e-15)
 
 
 # ---- the paper's Table 4: a representative unsafe-success lift_pot episode ----------------

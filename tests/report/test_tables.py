@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+from fsvla.metrics import CC_NORMALISATION
 from fsvla.report import load_runs
 from fsvla.report.data import NothingToReport, ReportInputError
 from fsvla.results import ResultStore
@@ -112,7 +113,8 @@ def test_protocol_header(report_data) -> None:
     assert (run.warmup, run.warmups_recorded, run.episodes_scored) == (1, 2, 8)
     assert run.sasr_lambda == 1.0 and run.faults == {"sim_error": 2}
     assert run.versions == VERSIONS
-    assert "Normalised CC" in p.cc_normalisation and p.differences == ()
+    assert p.cc_normalisation == CC_NORMALISATION and p.differences == ()
+    assert p.cc_scale.startswith("CC / T")
 
 
 def test_dissection_defaults_to_the_unsafe_success_with_the_largest_ret(report_data) -> None:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from fsvla.metrics import aggregate, episode_metrics
+from fsvla.metrics import CC_NORMALISATION, aggregate, episode_metrics
 from fsvla.metrics.trace import EpisodeTrace
 from fsvla.results import ResultStore, RunConfigMismatch, RunLocked, read_trace
 from fsvla.results.rows import episode_meta
@@ -24,7 +24,7 @@ def test_create_records_the_run(tmp_path: Path, config: RunConfig) -> None:
     with ResultStore.create(tmp_path / "run", config, VERSIONS) as store:
         info = store.info()
     assert info.config == config and info.versions == VERSIONS
-    assert "Normalised CC" in info.cc_normalisation
+    assert info.cc_normalisation == CC_NORMALISATION
     assert {p.name for p in (tmp_path / "run").iterdir()} == {"results.sqlite", "traces", "lock"}
     db = sqlite3.connect(tmp_path / "run" / "results.sqlite")
     assert db.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
