@@ -41,7 +41,7 @@ from fsvla.variation.apply import VisionApplier
 from fsvla.variation.language import Instruction, instruction_for
 from fsvla.variation.vision import VisionPerturbation, perturbation_for
 
-from .actions import ActionCodec, ArmCommand, ArmLayout, ControlMode
+from .actions import ActionCodec, ArmCommand, ArmLayout, ControlMode, joint_targets, tcp_target
 from .observations import assemble, check_instruction, observation_space, proprioception
 from .recording import EpisodeRecorder
 
@@ -155,7 +155,11 @@ class FsvlaEnv(gymnasium.Env):
         self._stepped = True
         ik_errors = self._apply(commands)
         monitor = self.monitor
-        for _ in range(self.substeps):
+        ramps, substep_dt = self._ramps, self.control_dt / self.substeps
+        for substep in range(self.substeps):
+            for arm, command, layout, start in ramps:  # joint_vel: the target moves at v
+                arm.set_joint_targets(joint_targets(command, layout, start,
+                                                    (substep + 1) * substep_dt))
             self.built.step(1)
             if monitor is not None:
                 monitor.record_substep()
@@ -217,20 +221,27 @@ class FsvlaEnv(gymnasium.Env):
     def _bind_kinematics(self) -> None:
         arms = self.built.robot.arms.values()
         self._kinematics = ({arm.name: ArmKinematics(arm) for arm in arms}
-                            if self.codec.mode is ControlMode.EE_POSE else {})
+                            if not self.codec.mode.in_joint_space else {})
 
     def _apply(self, commands: tuple[ArmCommand, ...]) -> dict[str, float]:
-        """Set drive targets; returns the IK position error (m) of arms that missed."""
+        """Set drive targets (a joint_vel command's position targets are set at every
+        substep, from ``self._ramps``); returns the IK position error (m) of arms that
+        missed."""
         robot = self.built.robot
         missed: dict[str, float] = {}
-        for command in commands:
+        self._ramps: list[tuple[LoadedArm, ArmCommand, ArmLayout, np.ndarray]] = []
+        for command, layout in zip(commands, self.codec.arms):
             arm = robot.arm(command.arm)
-            if command.joint_targets is not None:
-                arm.set_joint_targets(command.joint_targets)
+            if command.joint_velocity is not None:
+                arm.set_joint_velocity_targets(command.joint_velocity)
+                self._ramps.append((arm, command, layout, arm.qpos()))
+            elif command.in_joint_space:
+                arm.set_joint_targets(joint_targets(command, layout, arm.qpos()))
             else:
+                pose = arm.tcp_pose()
+                position, quaternion = tcp_target(command, pose.p, pose.q)
                 solution = self._kinematics[command.arm].inverse(
-                    tuple(command.tcp_position), tuple(command.tcp_quaternion),
-                    seed=arm.qpos(), restarts=2)
+                    tuple(position), tuple(quaternion), seed=arm.qpos(), restarts=2)
                 arm.set_joint_targets(solution.qpos)
                 if not solution.ok():
                     missed[command.arm] = solution.position_error

@@ -32,7 +32,7 @@ class _Model(BaseModel):
 
 
 class ActionSchema(_Model):
-    control_mode: str  # joint_pos or ee_pose
+    control_mode: str  # joint_pos, joint_delta, joint_vel, ee_pose or ee_delta (fsvla.env.actions)
     labels: tuple[str, ...]  # one per component: "<arm>.<joint>", "<arm>.gripper", "<arm>.qw", ...
     low: tuple[float, ...]
     high: tuple[float, ...]

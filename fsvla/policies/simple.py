@@ -63,14 +63,21 @@ def arm_block_sizes(episode: EpisodeInfo) -> list[int]:
             for arm in episode.action.arms]
 
 
+#: Control modes whose action is a change (or a velocity): holding still is zero.
+RELATIVE_MODES = ("joint_delta", "joint_vel", "ee_delta")
+
+
 def hold_action(observation: dict[str, Any], mode: str, sizes: list[int]) -> np.ndarray:
     """The action that keeps the robot where the observation says it is; ``sizes`` are
-    the arms' block sizes without the gripper (joints, or 7 for a pose)."""
+    the arms' block sizes without the gripper (joints, 7 for a pose, 6 for a pose delta)."""
     agent = observation["agent"]
     gripper = np.asarray(agent["gripper"], dtype=np.float32)
-    source = agent["qpos"] if mode == "joint_pos" else agent["tcp_pose"]
+    if mode in RELATIVE_MODES:
+        source = np.zeros(sum(sizes), dtype=np.float32)
+    else:
+        source = agent["qpos"] if mode == "joint_pos" else agent["tcp_pose"]
     blocks = np.split(np.asarray(source, dtype=np.float32), np.cumsum(sizes)[:-1])
     return np.concatenate([np.append(block, g) for block, g in zip(blocks, gripper)])
 
 
-__all__ = ["HoldStillPolicy", "RandomPolicy", "arm_block_sizes", "hold_action"]
+__all__ = ["RELATIVE_MODES", "HoldStillPolicy", "RandomPolicy", "arm_block_sizes", "hold_action"]

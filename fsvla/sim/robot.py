@@ -71,6 +71,17 @@ class LoadedArm:
         for index, target in zip(self.joint_indices, targets):
             joints[index].set_drive_target(float(target))
 
+    def set_joint_velocity_targets(self, velocities: Sequence[float]) -> None:
+        """Drive velocity targets for the arm joints (rad/s or m/s), in the spec's order."""
+        if len(velocities) != len(self.joint_indices):
+            raise ValueError(
+                f"arm `{self.name}` has {len(self.joint_indices)} joints, "
+                f"got {len(velocities)} velocities"
+            )
+        joints = self.articulation.active_joints
+        for index, velocity in zip(self.joint_indices, velocities):
+            joints[index].set_drive_velocity_target(float(velocity))
+
     def set_gripper(self, open: bool) -> None:
         """Drive the gripper's joints to their open or closed positions."""
         joints = self.articulation.active_joints

@@ -6,7 +6,14 @@ import math
 
 import numpy as np
 import pytest
-from fsvla.env.actions import ActionCodec, ArmLayout, ControlMode, InvalidActionError
+from fsvla.env.actions import (
+    ActionCodec,
+    ArmLayout,
+    ControlMode,
+    InvalidActionError,
+    joint_targets,
+    tcp_target,
+)
 
 LEFT = ArmLayout("left", ("j1", "j2"), (-1.0, -2.0), (1.0, 2.0))
 RIGHT = ArmLayout("right", ("j1", "j2"), (-1.0, -math.inf), (1.0, math.inf))
@@ -64,3 +71,35 @@ def test_space_matches_the_bounds() -> None:
     sample = space.sample()
     codec.decode(sample)  # anything the space samples is accepted
     assert np.all(space.low == codec.low)
+
+
+def test_joint_delta_and_joint_vel_add_to_the_measured_joints_within_their_limits() -> None:
+    delta = ActionCodec([LEFT], ControlMode.JOINT_DELTA)
+    assert delta.labels == ("left.j1", "left.j2", "left.gripper")
+    assert delta.high.tolist() == pytest.approx([0.5, 0.5, 1.0])
+    (command,) = delta.decode([0.1, -0.2, 0.5])
+    assert joint_targets(command, LEFT, [0.0, 1.0]).tolist() == pytest.approx([0.1, 0.8])
+    assert joint_targets(command, LEFT, [0.95, -1.9]).tolist() == pytest.approx([1.0, -2.0])
+    velocity = ActionCodec([LEFT], "joint_vel")
+    assert velocity.high.tolist() == pytest.approx([10.0, 10.0, 1.0])
+    (command,) = velocity.decode([2.0, -1.0, 1.0])
+    assert command.joint_velocity.tolist() == [2.0, -1.0] and command.in_joint_space
+    assert joint_targets(command, LEFT, [0.0, 0.0], elapsed=0.05).tolist() == pytest.approx(
+        [0.1, -0.05])
+
+
+def test_ee_delta_moves_the_tool_from_its_measured_pose_in_the_table_frame() -> None:
+    codec = ActionCodec([LEFT, RIGHT], ControlMode.EE_DELTA)
+    assert codec.labels[:7] == ("left.dx", "left.dy", "left.dz", "left.rx", "left.ry",
+                                "left.rz", "left.gripper")
+    assert codec.size == 14 and codec.high[:7].tolist() == pytest.approx([0.1] * 3 + [0.5] * 3 + [1])
+    turn = [0.0, 0.0, 0.01, 0.0, 0.0, math.pi / 8, 1.0]
+    left, right = codec.decode(turn + [0.0] * 6 + [0.0])
+    half = math.sqrt(0.5)
+    position, quaternion = tcp_target(left, [0.1, 0.2, 0.3], [half, 0.0, 0.0, half])  # yaw 90°
+    assert position.tolist() == pytest.approx([0.1, 0.2, 0.31])
+    yaw = 2 * math.atan2(quaternion[3], quaternion[0])
+    assert yaw == pytest.approx(math.pi / 2 + math.pi / 8)
+    assert tcp_target(right, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0])[1].tolist() == [1, 0, 0, 0]
+    with pytest.raises(InvalidActionError, match=r"action\[5\] \(left.rz\) = 0.6 is outside"):
+        codec.decode([0.0] * 5 + [0.6, 1.0] + [0.0] * 7)

@@ -22,8 +22,9 @@ def env(short_scenario: Path) -> FsvlaEnv:
 
 
 def _hold(env: FsvlaEnv, obs) -> np.ndarray:  # noqa: ANN001
-    sizes = [len(a.joint_indices) for a in env.built.robot.arms.values()]
-    return hold_action(obs, env.codec.mode.value, sizes)
+    joints = [len(a.joint_indices) for a in env.built.robot.arms.values()]
+    pose = {"ee_pose": 7, "ee_delta": 6}.get(env.codec.mode.value)
+    return hold_action(obs, env.codec.mode.value, [pose or n for n in joints])
 
 
 def test_check_env_passes(env: FsvlaEnv) -> None:
@@ -103,6 +104,47 @@ def test_ee_pose_control_holds_the_tool_where_it_is(short_scenario: Path) -> Non
         obs, _, _, _, info = env.step(target)
     assert "ik_error" not in info
     assert obs["agent"]["tcp_pose"][:3] == pytest.approx(start + [0.0, 0.0, 0.05], abs=0.01)
+
+
+def test_joint_velocity_moves_the_joints_at_the_commanded_speed(short_scenario: Path) -> None:
+    env = make(short_scenario, control_mode="joint_vel")
+    obs, _ = env.reset(seed=0)
+    start = obs["agent"]["qpos"].copy()
+    for _ in range(10):  # 0.5 s at +0.4 and -0.4 rad/s
+        obs, *_ = env.step(np.array([0.4, -0.4, 0, 0, 0, 0, 0, 1.0], dtype=np.float32))
+    moved = obs["agent"]["qpos"] - start
+    assert moved[:2] == pytest.approx([0.2, -0.2], abs=0.01) and np.abs(moved[2:]).max() < 0.01
+    stopped = obs["agent"]["qpos"].copy()
+    for _ in range(5):
+        obs, *_ = env.step(_hold(env, obs))
+    assert obs["agent"]["qpos"] == pytest.approx(stopped, abs=0.005)
+
+
+def test_joint_delta_pulls_each_joint_from_where_it_is(short_scenario: Path) -> None:
+    env = make(short_scenario, control_mode="joint_delta")
+    obs, _ = env.reset(seed=0)
+    start = obs["agent"]["qpos"].copy()
+    for _ in range(10):  # the drives (time constant 0.1 s) cover part of each step's 0.02 rad
+        obs, *_ = env.step(np.array([0.02, -0.02, 0, 0, 0, 0, 0, 1.0], dtype=np.float32))
+    moved = obs["agent"]["qpos"] - start
+    assert 0.05 < moved[0] <= 0.2 and -0.2 <= moved[1] < -0.05
+    assert np.abs(moved[2:]).max() < 0.01
+
+
+def test_ee_delta_moves_the_tool_and_zero_holds_it(short_scenario: Path) -> None:
+    env = make(short_scenario, control_mode="ee_delta")
+    obs, _ = env.reset(seed=0)
+    start = obs["agent"]["tcp_pose"].copy()
+    up = np.array([0.0, 0.0, 0.005, 0.0, 0.0, 0.0, 1.0], dtype=np.float32)  # 5 mm a step
+    for _ in range(10):
+        obs, _, _, _, info = env.step(up)
+    assert "ik_error" not in info
+    moved = obs["agent"]["tcp_pose"][:3] - start[:3]  # the drives cover part of each 5 mm
+    assert 0.015 < moved[2] <= 0.05 and np.abs(moved[:2]).max() < 0.005
+    reached = obs["agent"]["tcp_pose"].copy()
+    for _ in range(10):
+        obs, *_ = env.step(_hold(env, obs))
+    assert obs["agent"]["tcp_pose"][:3] == pytest.approx(reached[:3], abs=0.005)
 
 
 def test_terminate_on_violation(short_scenario: Path) -> None:
