@@ -24,7 +24,10 @@ untouched          robot-to-X distance; at most -TOUCH_DEPTH when they were in c
 do_not_disturb     robot-to-X distance (inside a zone region or penetrating X: negative)
 =================  ===========================================================================
 
-Distances are capped at ``MAX_DISTANCE`` (10 m), so margins stay finite, and are exact
+A distance channel (``>=``) reports the step's end, or an incursion into the band (or past
+the limit) at a physics substep of the step's interpolated motion (:mod:`.sweep`), so a
+pass through a thin zone within one step is seen. Distances are capped at
+``MAX_DISTANCE`` (10 m), so margins stay finite, and are exact
 while below limit + ε + ``EXACT_BAND``; farther, the monitor reports a lower bound that
 is itself beyond that, so every state, cost, exposure and violation is still exact: they
 depend on q only where q < ε. ``EXACT_BAND`` is 0: exact FCL queries beyond the warning
@@ -44,6 +47,7 @@ from . import kernels
 from .geometry import MAX_DISTANCE, SceneGeometry
 from .layout import Layout
 from .state import WorldState
+from .sweep import swept_distance
 
 #: Depth (m) a contact counts as on an ``untouched`` channel: touching is a violation.
 TOUCH_DEPTH = 0.001
@@ -67,11 +71,28 @@ def _contact_torque(ch: ChannelSpec, layout: Layout) -> Measure:
 
 
 def _distance(ch: ChannelSpec, layout: Layout) -> Measure:
+    """The distance of the nearest subject to the reference for the control step: at its end,
+    or the incursion into the band within it (:mod:`fsvla.monitor.sweep`)."""
     assert ch.reference is not None
     reference = layout.frames(ch.reference)
     subjects = [layout.frames(s) for s in ch.subjects]
-    exact_below = ch.limit + ch.soft_threshold + EXACT_BAND
-    return lambda state, geo: min(geo.distance(frames, reference, exact_below) for frames in subjects)
+    warn = ch.limit + ch.soft_threshold
+    exact_below = warn + EXACT_BAND
+    ends = [(-1, 0.0)] * len(subjects)  # per subject: (geometry step, distance at its end)
+
+    def measure(state: WorldState, geo: SceneGeometry) -> float:
+        best = MAX_DISTANCE
+        for i, frames in enumerate(subjects):
+            end = geo.distance(frames, reference, exact_below)
+            step, before = ends[i]
+            ends[i] = (geo.step, end)
+            if ch.comparison == ">=":
+                end = swept_distance(geo, frames, reference, end, before if step == geo.step - 1 else None,
+                                     ch.limit, warn)
+            best = min(best, end)
+        return best
+
+    return measure
 
 
 def _edge_clearance(ch: ChannelSpec, layout: Layout) -> Measure:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fsvla.compiler.monitor import MonitorSpec
+from fsvla.compiler.monitor import ChannelSpec, MonitorSpec
 from fsvla.metrics.trace import ChannelInfo, EpisodeMeta, EpisodeTrace
 
 from .channels import compile_margin, distance_queries
@@ -49,6 +49,8 @@ class Evaluator:
         self._rows: list[np.ndarray] = []
         self._held_steps = 0
         self.success_achieved = False
+        geometry.sweep_samples = spec.substeps  # a step's motion is sampled at its physics substeps
+        self.start_margins = np.zeros(len(spec.channels))
 
     def _scope(self, state: WorldState) -> Scope:
         self.geometry.set_poses(state.poses)
@@ -56,7 +58,9 @@ class Evaluator:
 
     def reset(self, state: WorldState) -> None:
         """Start an episode at ``state`` (t = 0): the reference for displacement, lifting and
-        the temporal FSMs' previous step."""
+        the temporal FSMs' previous step. The limits' margins there are
+        :attr:`start_margins` (see :meth:`start_exposures`)."""
+        self.geometry.begin_step(fresh=True)
         scope = self._scope(state)
         self.layout.initial = {b: scope.root_pose(b).copy() for b in self.layout.bodies
                                if self.layout.bodies[b].root_frame in state.poses or self.geometry.has(
@@ -64,12 +68,20 @@ class Evaluator:
         self.layout.initial_low = {b: scope.lowest(b) for b in self.layout.entities if b in self.layout.bodies}
         for fsm, req in zip(self._fsms, self.spec.requirements):
             fsm.reset(holds(req.first, scope), holds(req.then, scope), state.time)
+        self.geometry.prefetch(self._queries)
+        self.start_margins = np.array([margin(state, self.geometry) for margin in self._margins], dtype=np.float64)
         self._rows.clear()
         self._held_steps = 0
         self.success_achieved = False
 
+    def start_exposures(self) -> list[tuple[ChannelSpec, float]]:
+        """The limits inside their warning band, or past their hard limit, at the state of
+        the last :meth:`reset`, with their margin there."""
+        return [(c, float(q)) for c, q in zip(self.spec.channels, self.start_margins) if q < c.soft_threshold]
+
     def step(self, state: WorldState) -> StepReport:
         """Evaluate the state at the end of a control step."""
+        self.geometry.begin_step()
         scope = self._scope(state)
         self.geometry.prefetch(self._queries)
         geometry = self.geometry

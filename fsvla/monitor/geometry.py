@@ -137,6 +137,10 @@ class SceneGeometry:
         self._group_frames: dict[frozenset[str], NDArray[np.int64]] = {}
         self._frame_points: dict[str, NDArray[np.float64]] = {}
         self._frozen = False
+        #: Instants a control step's motion is sampled at (the physics substeps; 1: its end only).
+        self.sweep_samples = 1
+        self.step = 0  # control steps begun (:meth:`begin_step`)
+        self._start: NDArray[np.float64] | None = None  # every frame's pose where the step began
 
     # --- building -------------------------------------------------------------------------
 
@@ -203,6 +207,10 @@ class SceneGeometry:
                               if idx}
         self._update_bounds()
         self._moves_made += 1  # every bound may have changed
+        # how far each frame's geometry reaches from the frame's origin, and where a step began
+        self._reach = np.zeros(len(self.frames))
+        np.maximum.at(self._reach, self._pf, np.sqrt((self._c ** 2).sum(axis=1)) + self._radius)
+        self._start_buffer, self._start = np.empty_like(self._pose_array), None
         self._frozen = True
 
     def has(self, frame: str) -> bool:
@@ -246,6 +254,38 @@ class SceneGeometry:
             kernels.update_bounds(self._pose_array, self._pf, self._c, self._h, self._piece_row,
                                   self._plo, self._phi, self._flo, self._fhi)
 
+    def begin_step(self, fresh: bool = False) -> None:
+        """Mark the start of a control step: the poses held now are where its motion begins
+        (``fresh``: nowhere, as at reset). :func:`fsvla.monitor.sweep.swept_distance` reads
+        them as :attr:`step_start`."""
+        if not self._frozen:
+            self._freeze()
+        self.step += 1
+        if fresh:
+            self._start = None
+        else:
+            np.copyto(self._start_buffer, self._pose_array)
+            self._start = self._start_buffer
+
+    @property
+    def step_start(self) -> NDArray[np.float64] | None:
+        """Every frame's pose where the current control step began (None at reset)."""
+        return self._start
+
+    @property
+    def poses_array(self) -> NDArray[np.float64]:
+        """Every frame's pose now, as rows (:meth:`frame_rows`) of one array."""
+        if not self._frozen:
+            self._freeze()
+        return self._pose_array
+
+    @property
+    def reach(self) -> NDArray[np.float64]:
+        """Per frame: how far its geometry reaches from its origin (0 with no geometry)."""
+        if not self._frozen:
+            self._freeze()
+        return self._reach
+
     def pose(self, frame: str) -> Matrix4:
         if not self._frozen:
             self._freeze()
@@ -268,11 +308,15 @@ class SceneGeometry:
 
     def version(self, frames: frozenset[str]) -> int:
         """A number that grows whenever a frame of the group moves."""
+        return kernels.stamp_total(self._stamp, self.frame_rows(frames))
+
+    def frame_rows(self, frames: frozenset[str]) -> NDArray[np.int64]:
+        """The group's frames as rows of the pose array (:attr:`step_start`, :attr:`reach`)."""
         index = self._group_frames.get(frames)
         if index is None:
             index = self._group_frames[frames] = np.array(
                 [self._frame_index[f] for f in frames if f in self._frame_index], dtype=np.int64)
-        return kernels.stamp_total(self._stamp, index)
+        return index
 
     def _group(self, frames: frozenset[str]) -> NDArray[np.int64]:
         found = self._groups.get(frames)
@@ -416,6 +460,15 @@ class SceneGeometry:
                                          self._phi, ia, ib, lower, known, CARRY_SLACK, below, order)
         return lower, known, order, n, beyond
 
+    def within_step(self, a: frozenset[str], b: frozenset[str], first: float,
+                    before: float | None = None) -> StepSampler:
+        """The distance of two groups inside the current control step (from :meth:`begin_step`
+        to now), at the instants from ``first`` to ``1 - first`` of it (``before``: their
+        distance where it began, if known): see :class:`StepSampler`."""
+        if not self._frozen:
+            self._freeze()
+        return StepSampler(self, a, b, first, -np.inf if before is None else before)
+
     def pieces(self, frames: frozenset[str]) -> NDArray[np.int64]:
         """Indices of the frames' pieces (sorted), as the rows/columns of :meth:`near`."""
         return self._group(frames)
@@ -443,4 +496,79 @@ class SceneGeometry:
         return self._flo[rows].min(axis=0), self._fhi[rows].max(axis=0)
 
 
-__all__ = ["MAX_DISTANCE", "POSE_TOLERANCE", "SceneGeometry", "shapes_of_sapien"]
+
+class StepSampler:
+    """Two groups' distance inside a control step, every frame moving along the straight
+    interpolation of its poses at the step's two ends (``kernels.interpolate_frames``).
+
+    Each piece pair has a bound over the whole step (:attr:`floor` is the smallest): from
+    its bound at the step's start (its boxes' gap there, or the groups' distance there) and
+    at its end (the one :meth:`distance` carries), each less how far its pieces can travel
+    from there (``kernels.step_bounds``).
+    Calling it with ``(s, exact_below)`` gives the distance at the fraction ``s`` of the
+    step, exact below ``exact_below``, else a lower bound at least that large: only pairs
+    whose step bound is below ``exact_below`` are looked at, nearest bound first, and FCL
+    measures those whose bound at ``s`` (their boxes' gap there, and their end bound less
+    the travel left) is still below. Nothing is memoised; the FCL transforms it sets are
+    set again when next needed."""
+
+    def __init__(self, geo: SceneGeometry, a: frozenset[str], b: frozenset[str], first: float, before: float):
+        self._geo = geo
+        start = geo._start if geo._start is not None else geo._pose_array
+        self._start, self._end = start, geo._pose_array
+        ia, ib, _, _ = geo._pair(a, b)
+        self._ia, self._ib = ia, ib
+        self._at_end = geo._carry((a, b), ia, ib, -np.inf)[0].copy()
+        self._travel_a = kernels.piece_travel(start, self._end, geo._pf, geo._c, geo._radius, ia)
+        self._travel_b = kernels.piece_travel(start, self._end, geo._pf, geo._c, geo._radius, ib)
+        self._step, self._at_start = np.empty(len(ia) * len(ib)), np.empty(len(ia) * len(ib))
+        kernels.step_bounds(start, geo._pf, geo._c, geo._h, ia, ib, self._at_end, self._travel_a, self._travel_b,
+                            first, before, self._step, self._at_start)
+        self.floor = float(self._step.min()) if len(self._step) else MAX_DISTANCE
+        self._frames = np.union1d(geo._pf[ia], geo._pf[ib])
+        self._poses = self._end.copy()
+
+    def floors(self, s: NDArray[np.float64], below: float) -> NDArray[np.float64]:
+        """A lower bound of the distance at each instant ``s``, from the pairs whose step
+        bound is below ``below`` (the others' are at least ``below``): each pair's bound at
+        the step's start and end, less how far it can travel from there to the instant."""
+        pairs = np.flatnonzero(self._step < below)
+        if len(pairs) == 0:
+            return np.full(len(s), max(self.floor, below))
+        nb = len(self._ib)
+        travel = (self._travel_a[pairs // nb] + self._travel_b[pairs % nb])[:, None]
+        lower = np.maximum(self._at_start[pairs, None] - travel * s, self._at_end[pairs, None] - travel * (1.0 - s))
+        return np.minimum(lower.min(axis=0), below)
+
+    def __call__(self, s: float, exact_below: float) -> float:
+        geo, ia, ib = self._geo, self._ia, self._ib
+        pairs = np.flatnonzero(self._step < exact_below)
+        if len(pairs) == 0:  # no pair comes that close at any instant
+            return self.floor
+        kernels.interpolate_frames(self._start, self._end, self._frames, s, self._poses)
+        bounds = np.empty(len(pairs))
+        kernels.instant_bounds(self._poses, geo._pf, geo._c, geo._h, ia, ib, pairs, self._at_end, self._travel_a,
+                               self._travel_b, 1.0 - s, bounds)
+        rest = float(self._step[self._step >= exact_below].min(initial=MAX_DISTANCE))  # the pairs left out
+        best, placed, nb = MAX_DISTANCE, set(), len(ib)
+        for n in np.argsort(bounds, kind="stable").tolist():
+            if bounds[n] >= min(best, exact_below):
+                return min(best, float(bounds[n]), rest)
+            k = int(pairs[n])
+            pa, pb = int(ia[k // nb]), int(ib[k % nb])
+            for p in (pa, pb):
+                if p not in placed:
+                    self._place(p)
+                    placed.add(p)
+            best = min(best, signed_distance(geo._pieces[pa].obj, geo._pieces[pb].obj))
+        return min(best, rest)
+
+    def _place(self, p: int) -> None:
+        geo = self._geo
+        kernels.place_piece(self._poses, geo._pf[p], geo._locals[p], geo._rotations[p], geo._translations[p])
+        obj = geo._pieces[p].obj
+        obj.setRotation(geo._rotations[p])
+        obj.setTranslation(geo._translations[p])
+        geo._placed[p] = -1  # placed at its frame's pose again when next used
+
+__all__ = ["MAX_DISTANCE", "POSE_TOLERANCE", "SceneGeometry", "StepSampler", "shapes_of_sapien"]

@@ -290,6 +290,166 @@ def stamp_total(stamp: NDArray[np.int64], frames: NDArray[np.int64]) -> int:
     return total
 
 
+@njit(cache=True, nogil=True)
+def sweep_speed(start: NDArray[np.float64], poses: NDArray[np.float64], frames: NDArray[np.int64],
+                reach: NDArray[np.float64]) -> float:
+    """How fast a point of the frames' geometry can move, per unit of a control step, while
+    each frame goes from pose ``start`` to pose ``poses`` along the straight interpolation
+    (its origin on a line, its rotation about one axis at a constant rate): the largest over
+    the frames of the origin's shift plus ``reach`` times the angle turned."""
+    best = 0.0
+    for f in frames:
+        shift = 0.0
+        trace = 0.0
+        for i in range(3):
+            d = poses[f, i, 3] - start[f, i, 3]
+            shift += d * d
+            for j in range(3):
+                trace += start[f, i, j] * poses[f, i, j]  # the trace of start^T poses
+        turn = math.acos(min(1.0, max(-1.0, 0.5 * (trace - 1.0))))
+        best = max(best, math.sqrt(shift) + reach[f] * turn)
+    return best
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _turn(start: NDArray[np.float64], end: NDArray[np.float64], f: int) -> tuple[float, float, float, float]:
+    """The axis (x, y, z) and angle of the rotation from frame ``f``'s orientation in
+    ``start`` to the one in ``end``, in the frame's starting axes (start^T end)."""
+    r = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            total = 0.0
+            for k in range(3):
+                total += start[f, k, i] * end[f, k, j]
+            r[i, j] = total
+    angle = math.acos(min(1.0, max(-1.0, 0.5 * (r[0, 0] + r[1, 1] + r[2, 2] - 1.0))))
+    x, y, z = r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]  # 2 sin(angle) times the axis
+    if angle > math.pi - 1e-3:  # sin(angle) too small to divide by: the axis from the symmetric part
+        k = 0 if r[0, 0] >= r[1, 1] and r[0, 0] >= r[2, 2] else (1 if r[1, 1] >= r[2, 2] else 2)
+        u = np.empty(3)
+        for i in range(3):
+            u[i] = r[k, i] + r[i, k] if i != k else 1.0 + 2.0 * r[k, k] - r[0, 0] - r[1, 1] - r[2, 2]
+        sign = -1.0 if u[0] * x + u[1] * y + u[2] * z < 0.0 else 1.0
+        x, y, z = sign * u[0], sign * u[1], sign * u[2]
+    norm = math.sqrt(x * x + y * y + z * z)
+    if norm <= 0.0:
+        return 1.0, 0.0, 0.0, 0.0
+    return x / norm, y / norm, z / norm, angle
+
+
+@njit(cache=True, nogil=True)
+def interpolate_frames(start: NDArray[np.float64], end: NDArray[np.float64], frames: NDArray[np.int64], s: float,
+                       out: NDArray[np.float64]) -> None:
+    """``out[f]`` for each of ``frames``: its pose the fraction ``s`` of the way from ``start``
+    to ``end`` (the origin along the line between them, the orientation turned ``s`` of the
+    way about the fixed axis that takes one to the other: ``fsvla.monitor.sweep.interpolate``)."""
+    for f in frames:
+        x, y, z, angle = _turn(start, end, f)
+        c, si = math.cos(s * angle), math.sin(s * angle)
+        t = 1.0 - c
+        turn = np.array([[c + x * x * t, x * y * t - z * si, x * z * t + y * si],
+                         [y * x * t + z * si, c + y * y * t, y * z * t - x * si],
+                         [z * x * t - y * si, z * y * t + x * si, c + z * z * t]])
+        for i in range(3):
+            for j in range(3):
+                total = 0.0
+                for k in range(3):
+                    total += start[f, i, k] * turn[k, j]
+                out[f, i, j] = total
+            out[f, i, 3] = (1.0 - s) * start[f, i, 3] + s * end[f, i, 3]
+            out[f, 3, i] = 0.0
+        out[f, 3, 3] = 1.0
+
+
+@njit(cache=True, nogil=True)
+def piece_travel(start: NDArray[np.float64], end: NDArray[np.float64], piece_frame: NDArray[np.int64],
+                 centre: NDArray[np.float64], radius: NDArray[np.float64], pieces: NDArray[np.int64]
+                 ) -> NDArray[np.float64]:
+    """How far a point of each of ``pieces`` can travel over the step's interpolated motion
+    (:func:`interpolate_frames`): its frame origin's shift plus the angle turned times the
+    piece's reach from that origin (its box centre's distance plus its radius)."""
+    out = np.empty(pieces.shape[0])
+    for n in range(pieces.shape[0]):
+        p = pieces[n]
+        f = piece_frame[p]
+        shift = 0.0
+        for i in range(3):
+            d = end[f, i, 3] - start[f, i, 3]
+            shift += d * d
+        reach = math.sqrt(centre[p, 0] ** 2 + centre[p, 1] ** 2 + centre[p, 2] ** 2) + radius[p]
+        out[n] = math.sqrt(shift) + _turn(start, end, f)[3] * reach
+    return out
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _piece_boxes(poses: NDArray[np.float64], piece_frame: NDArray[np.int64], centre: NDArray[np.float64],
+                 half: NDArray[np.float64], a: NDArray[np.int64], b: NDArray[np.int64]
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """World boxes (rows: ``a``'s pieces, then ``b``'s) with their frames at ``poses``."""
+    na, nb = a.shape[0], b.shape[0]
+    lo = np.empty((na + nb, 3))
+    hi = np.empty((na + nb, 3))
+    for n in range(na + nb):
+        p = a[n] if n < na else b[n - na]
+        f = piece_frame[p]
+        for i in range(3):
+            c = poses[f, i, 3]
+            h = 0.0
+            for j in range(3):
+                c += poses[f, i, j] * centre[p, j]
+                h += abs(poses[f, i, j]) * half[p, j]
+            lo[n, i], hi[n, i] = c - h, c + h
+    return lo, hi
+
+
+@njit(cache=True, nogil=True)
+def step_bounds(start: NDArray[np.float64], piece_frame: NDArray[np.int64], centre: NDArray[np.float64],
+                half: NDArray[np.float64], a: NDArray[np.int64], b: NDArray[np.int64], at_end: NDArray[np.float64],
+                travel_a: NDArray[np.float64], travel_b: NDArray[np.float64], first: float, before: float,
+                out: NDArray[np.float64], at_start: NDArray[np.float64]) -> None:
+    """``out[i * len(b) + j]``: a lower bound of the signed distance of pieces ``a[i]`` and
+    ``b[j]`` at every instant from ``first`` to ``1 - first`` of a step, from their bound at
+    its start (``at_start``: the larger of their boxes' gap there, frames at ``start``,
+    where apart, and ``before``, the groups' distance there) and their bound ``at_end``,
+    each less how far the two can travel between that end of the step and the instant."""
+    na, nb = a.shape[0], b.shape[0]
+    lo, hi = _piece_boxes(start, piece_frame, centre, half, a, b)
+    for i in range(na):
+        for j in range(nb):
+            k = i * nb + j
+            travel = travel_a[i] + travel_b[j]
+            end = at_end[k]
+            gap = _distance(lo, hi, i, na + j)
+            gap = max(gap if gap > 0.0 else -np.inf, before)
+            at_start[k] = gap
+            if gap == -np.inf:  # nothing known at the start
+                out[k] = end - travel * (1.0 - first)
+            elif travel <= 0.0:
+                out[k] = max(gap, end)
+            else:  # the larger of two bounds is smallest where they cross
+                s = min(1.0 - first, max(first, (gap - end + travel) / (2.0 * travel)))
+                out[k] = max(gap - travel * s, end - travel * (1.0 - s))
+
+
+@njit(cache=True, nogil=True)
+def instant_bounds(poses: NDArray[np.float64], piece_frame: NDArray[np.int64], centre: NDArray[np.float64],
+                   half: NDArray[np.float64], a: NDArray[np.int64], b: NDArray[np.int64], pairs: NDArray[np.int64],
+                   at_end: NDArray[np.float64], travel_a: NDArray[np.float64], travel_b: NDArray[np.float64],
+                   rest: float, out: NDArray[np.float64]) -> None:
+    """``out[n]``: a lower bound of the signed distance of the piece pair ``pairs[n]`` (``i *
+    len(b) + j``: ``a[i]`` and ``b[j]``) with their frames at ``poses``, the fraction ``1 -
+    rest`` of a step that ends with the bounds ``at_end``: the larger of their boxes' gap
+    (where they are apart) and ``at_end`` less how far the two can travel in the ``rest``."""
+    na, nb = a.shape[0], b.shape[0]
+    lo, hi = _piece_boxes(poses, piece_frame, centre, half, a, b)
+    for n in range(pairs.shape[0]):
+        k = pairs[n]
+        i, j = k // nb, k % nb
+        gap = _distance(lo, hi, i, na + j)
+        carried = at_end[k] - (travel_a[i] + travel_b[j]) * rest
+        out[n] = max(gap, carried) if gap > 0.0 else carried
+
+
 @functools.cache
 def warm_up() -> None:
     """Load every kernel now (from numba's disk cache, compiling on a first run), so that
@@ -308,7 +468,29 @@ def warm_up() -> None:
     inside_margin(boxes, poses[0], poses[1], 0.0, 0.0, 1.0, 1.0)
     place_piece(poses, 0, poses[1], np.zeros((3, 3)), np.zeros(3))
     stamp_total(rows, rows)
+    sweep_speed(poses, poses, rows, values)
+    interpolate_frames(poses, poses.copy(), rows, 0.5, poses.copy())
+    travel = piece_travel(poses, poses, rows, boxes, values, rows)
+    step_bounds(poses, rows, boxes, boxes, rows, rows, np.zeros(4), travel, travel, 0.04, -np.inf, np.zeros(4),
+                np.zeros(4))
+    instant_bounds(poses, rows, boxes, boxes, rows, rows, rows, np.zeros(4), travel, travel, 0.5, np.zeros(2))
 
 
-__all__ = ["any_within", "apply_poses", "carry_bounds", "contact_gate", "inside_margin", "move_frames", "nearest_per_query", "place_piece",
-           "stamp_total", "update_bounds", "warm_up"]
+__all__ = [
+    "any_within",
+    "apply_poses",
+    "carry_bounds",
+    "contact_gate",
+    "inside_margin",
+    "instant_bounds",
+    "interpolate_frames",
+    "move_frames",
+    "nearest_per_query",
+    "piece_travel",
+    "place_piece",
+    "stamp_total",
+    "step_bounds",
+    "sweep_speed",
+    "update_bounds",
+    "warm_up",
+]
