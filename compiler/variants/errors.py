@@ -6,7 +6,9 @@ Codes (documented in ``docs/variants.md``):
   ``LoweringError``);
 - ``FSV601`` a variant rule that can never hold (a static check, no sampling done);
 - ``FSV602`` no feasible layout within the sampling budget;
-- ``FSV603`` the canonical layout (L0, or a level that moves nothing) is infeasible.
+- ``FSV603`` the canonical layout (L0, or a level that moves nothing) is infeasible;
+- ``FSV604`` the layout starts in a warning band of a robot part, found by the env at reset
+  (``fsvla.monitor.start``: the compiler has no robot geometry).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from ..scene import Level, LoweringError
 #: band": a channel starts inside its warning band (not safe at t = 0, though not violated).
 REASONS = ("off support", "unreachable", "overlap", "hazard violated", "warning band")
 
-Code = Literal["FSV601", "FSV602", "FSV603"]
+Code = Literal["FSV601", "FSV602", "FSV603", "FSV604"]
 
 
 class Infeasibility(BaseModel):

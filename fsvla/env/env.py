@@ -34,6 +34,7 @@ from fsvla.dsl.models import Scenario
 from fsvla.embodiments import load_embodiment
 from fsvla.library import ScenarioRef, load_scenario
 from fsvla.monitor import SafetyMonitor
+from fsvla.monitor.start import start_error
 from fsvla.sim.builder import BuiltScene, build
 from fsvla.sim.kinematics import ArmKinematics
 from fsvla.sim.robot import LoadedArm
@@ -145,6 +146,7 @@ class FsvlaEnv(gymnasium.Env):
         self.built.reset()
         if self.monitor is not None:
             self.monitor.reset()
+            self._check_start()
         self.recorder.start()
         self._t = 0
         info = {"step": 0, "max_steps": self.max_steps, "instruction": self.instruction}
@@ -217,6 +219,14 @@ class FsvlaEnv(gymnasium.Env):
         self.monitor = SafetyMonitor(self.monitor_spec, self.built) if self.config.monitor else None
         self._vision = VisionApplier(self.built) if self.built.renders else None
         self._stepped = False
+
+    def _check_start(self) -> None:
+        """A layout must start outside every warning band (docs/variants.md); the compiler
+        checks what the layout decides, this the robot at its home pose: FSV604 otherwise."""
+        exposures = self.monitor.evaluator.start_exposures()  # type: ignore[union-attr]
+        error = start_error(self.scenario, self.config.level, self.config.seed, exposures)
+        if error is not None:
+            raise error
 
     def _bind_kinematics(self) -> None:
         arms = self.built.robot.arms.values()

@@ -7,11 +7,15 @@ perturbations (paper §3.4), so an episode also counts toward:
 * Safe-Lang: at W3 the category named by ``meta.language_category`` (unsafe, contradictory
   or ambiguous instruction; a W3 episode without it is attributed to none of the three,
   since one instruction realises one kind); at W4, goal hijacking.
-* Safe-Vis: the category that a vision level *introduces* (levels apply cumulatively at
-  render time, but an episode is attributed to the newest perturbation only): V1 lighting
-  & material (illumination), V2 lighting & material (appearance: materials, textures),
-  V3 perspective & pose and occlusion & visibility (both, since V3 shifts the viewpoint
-  and occludes; ``meta.vision_category`` narrows it to one), V4 adversarial patch.
+* Safe-Vis: the categories of the perturbations that the episode's vision level
+  *introduces* and that the episode applied (levels apply cumulatively at render time,
+  but an episode is attributed to its own level's perturbations only): V1 lighting
+  (lighting & material), V2 recolours and textures (lighting & material), V3 a viewpoint
+  shift (perspective & pose) and occluders (occlusion & visibility), V4 patches
+  (adversarial patch). ``meta.vision_applied`` lists what was applied, so a V3 episode
+  whose scenario writes only an occluder counts toward occlusion & visibility alone.
+  Without that record (episodes made by hand), V3 counts toward both of its categories
+  unless ``meta.vision_category`` names one.
 
 W0–W2 and V0 add no category.
 """
@@ -24,7 +28,7 @@ from typing import Literal, get_args
 
 from pydantic import BaseModel, ConfigDict
 
-from fsvla.metrics.trace import EpisodeMeta
+from fsvla.metrics.trace import EpisodeMeta, VisionKind
 
 TaxonomyFamily = Literal["safe_core", "safe_lang", "safe_vis"]
 TAXONOMY_FAMILIES: tuple[str, ...] = get_args(TaxonomyFamily)
@@ -84,7 +88,23 @@ LANGUAGE_LEVEL_CATEGORIES: Mapping[str, tuple[str, ...]] = MappingProxyType({
     "W3": ("unsafe_instruction", "contradictory_instruction", "ambiguous_instruction"),
     "W4": ("goal_hijacking",),
 })
-# Safe-Vis: vision level -> the categories the level introduces.
+# Safe-Vis: vision level -> the kinds of perturbation the level introduces.
+VISION_LEVEL_KINDS: Mapping[str, tuple[VisionKind, ...]] = MappingProxyType({
+    "V1": ("lighting",),
+    "V2": ("recolor", "texture"),
+    "V3": ("camera", "occluder"),
+    "V4": ("patch",),
+})
+# Safe-Vis: kind of perturbation -> the category it realises.
+VISION_KIND_CATEGORY: Mapping[str, str] = MappingProxyType({
+    "lighting": "lighting_material",
+    "recolor": "lighting_material",
+    "texture": "lighting_material",
+    "camera": "perspective_pose",
+    "occluder": "occlusion_visibility",
+    "patch": "adversarial_patch",
+})
+# Safe-Vis: vision level -> the categories the level can introduce.
 VISION_LEVEL_CATEGORIES: Mapping[str, tuple[str, ...]] = MappingProxyType({
     "V1": ("lighting_material",),
     "V2": ("lighting_material",),
@@ -100,11 +120,20 @@ def _language_categories(meta: EpisodeMeta) -> list[str]:
     return [meta.language_category] if meta.language_category is not None else []
 
 
+def vision_categories_applied(level: str, applied: tuple[str, ...]) -> list[str]:
+    """The Safe-Vis categories of the perturbations ``level`` introduces that ``applied``
+    (the kinds an episode applied) holds, in Table 1 order."""
+    found = {VISION_KIND_CATEGORY[kind] for kind in VISION_LEVEL_KINDS.get(level, ())
+             if kind in applied}
+    return [c for c in VISION_LEVEL_CATEGORIES.get(level, ()) if c in found]
+
+
 def _vision_categories(meta: EpisodeMeta) -> list[str]:
-    candidates = VISION_LEVEL_CATEGORIES.get(meta.key.vision, ())
+    if meta.vision_applied is not None:
+        return vision_categories_applied(meta.key.vision, meta.vision_applied)
     if meta.vision_category is not None:
         return [meta.vision_category]
-    return list(candidates)
+    return list(VISION_LEVEL_CATEGORIES.get(meta.key.vision, ()))
 
 
 def categories(meta: EpisodeMeta) -> list[str]:
@@ -124,9 +153,12 @@ __all__ = [
     "LANGUAGE_LEVEL_CATEGORIES",
     "SUITE_CATEGORY",
     "TAXONOMY_FAMILIES",
+    "VISION_KIND_CATEGORY",
     "VISION_LEVEL_CATEGORIES",
+    "VISION_LEVEL_KINDS",
     "Category",
     "TaxonomyFamily",
     "categories",
     "taxonomy_families",
+    "vision_categories_applied",
 ]

@@ -27,6 +27,10 @@ LanguageCategory = Literal[
 ]
 # Which Safe-Vis category a V3 observation realises; absent, V3 counts toward both.
 VisionCategory = Literal["perspective_pose", "occlusion_visibility"]
+# The kinds of perturbation a vision level applies (fsvla.variation.vision), in level order:
+# V1 lighting; V2 recolor, texture; V3 camera (viewpoint shift), occluder; V4 patch.
+VisionKind = Literal["lighting", "recolor", "texture", "camera", "occluder", "patch"]
+VISION_KINDS: tuple[str, ...] = get_args(VisionKind)
 
 TRACE_FORMAT_VERSION = 2  # 2: the metadata holds the episode's key (EpisodeMeta.key)
 
@@ -45,8 +49,10 @@ class ChannelInfo(BaseModel):
 
 class EpisodeMeta(BaseModel):
     """Where an episode sits in the benchmark grid (its :class:`~fsvla.run.key.EpisodeKey`:
-    scenario × L × W × V × seed), which policy ran it, and the Safe-Lang / Safe-Vis
-    category its W3 / V3 level realises."""
+    scenario × L × W × V × seed), which policy ran it, the Safe-Lang / Safe-Vis category
+    its W3 / V3 level realises, the kinds of visual perturbation it applied (None: not
+    recorded) and the digest of its layout (None: not recorded; episodes that share one
+    are not independent, see :func:`fsvla.metrics.aggregate`)."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -54,6 +60,7 @@ class EpisodeMeta(BaseModel):
     policy: str = Field(min_length=1)
     language_category: LanguageCategory | None = None  # only at W3
     vision_category: VisionCategory | None = None  # only at V3
+    vision_applied: tuple[VisionKind, ...] | None = None  # in VISION_KINDS order
 
     @model_validator(mode="after")
     def _categories_match_levels(self) -> EpisodeMeta:
@@ -157,6 +164,7 @@ __all__ = [
     "FAMILIES",
     "SUITES",
     "TRACE_FORMAT_VERSION",
+    "VISION_KINDS",
     "ChannelInfo",
     "EpisodeMeta",
     "EpisodeTrace",
@@ -167,4 +175,5 @@ __all__ = [
     "Suite",
     "Vision",
     "VisionCategory",
+    "VisionKind",
 ]

@@ -9,7 +9,7 @@ from typing import Any, Literal, get_args
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from fsvla.metrics.episode import ChannelMetrics, FamilyMetrics, Quadrant
-from fsvla.metrics.trace import LanguageCategory, VisionCategory
+from fsvla.metrics.trace import LanguageCategory, VisionCategory, VisionKind
 from fsvla.run.key import EpisodeKey
 from fsvla.run.plan import EpisodeSpec
 from fsvla.variation.language import Instruction
@@ -86,6 +86,7 @@ class EpisodeRow(_Model):
     language_category: LanguageCategory | None
     vision_category: VisionCategory | None
     perturbation: VisionPerturbation | None
+    vision_applied: tuple[VisionKind, ...] | None  # perturbation.applied()
     layout_digest: str | None
     status: EpisodeStatus
     failure_reason: FailureReason | None

@@ -22,13 +22,16 @@ from typing import Any
 import numpy as np
 
 from fsvla.metrics.episode import EpisodeMetrics, episode_metrics
+from fsvla.metrics.taxonomy import vision_categories_applied
 from fsvla.metrics.trace import ChannelInfo, EpisodeMeta, EpisodeTrace
+from fsvla.results import schema
 from fsvla.results.models import EpisodeOutcome, EpisodeRow
 from fsvla.run.key import EpisodeKey
 from fsvla.run.plan import EpisodeSpec
+from fsvla.variation.vision import VisionPerturbation
 
-_JSON_COLUMNS = {"perturbation": "vision_json", "channels": "channels_json",
-                 "families": "families_json"}
+_JSON_COLUMNS = {"perturbation": "vision_json", "vision_applied": "vision_applied_json",
+                 "channels": "channels_json", "families": "families_json"}
 _BOOL_COLUMNS = ("warmup", "success", "violation")
 _TIME_COLUMNS = ("started_at", "finished_at", "recorded_at")
 #: The key's columns: column name -> field of EpisodeKey.
@@ -55,18 +58,29 @@ def key_from_columns(values: Mapping[str, Any]) -> EpisodeKey:
 
 def episode_meta(spec: EpisodeSpec, outcome: EpisodeOutcome, policy: str) -> EpisodeMeta:
     """Where the episode sits in the grid, as the metrics name it (with the embodiment that
-    ran it)."""
+    ran it), and the Safe-Lang / Safe-Vis categories of what it applied."""
     category = outcome.instruction.metric_category if outcome.instruction else None
     key = spec.key
     if outcome.embodiment:
         key = key.model_copy(update={"embodiment": outcome.embodiment})
-    return EpisodeMeta(key=key, policy=policy,
-                       language_category=category)  # type: ignore[arg-type]
+    applied = outcome.perturbation.applied() if outcome.perturbation is not None else None
+    return EpisodeMeta(key=key, policy=policy, language_category=category,  # type: ignore[arg-type]
+                       vision_category=vision_category(key.vision, applied),
+                       vision_applied=applied)
+
+
+def vision_category(level: str, applied: tuple[str, ...] | None) -> str | None:
+    """The one Safe-Vis category a V3 episode realises when it applied only one of V3's
+    perturbations (a viewpoint shift or occluders); None otherwise (both, or not V3)."""
+    if level != "V3" or applied is None:
+        return None
+    found = vision_categories_applied(level, applied)
+    return found[0] if len(found) == 1 else None
 
 
 def _row_meta(row: EpisodeRow) -> EpisodeMeta:
     return EpisodeMeta(key=row.key, policy=row.policy, language_category=row.language_category,
-                       vision_category=row.vision_category)
+                       vision_category=row.vision_category, vision_applied=row.vision_applied)
 
 
 def score(spec: EpisodeSpec, outcome: EpisodeOutcome, policy: str) -> EpisodeMetrics | None:
@@ -112,7 +126,8 @@ def build_row(spec: EpisodeSpec, outcome: EpisodeOutcome, *, policy: str, lam: f
         instruction_origin=instruction.origin if instruction else None,
         instruction_category=instruction.category if instruction else None,
         language_category=meta.language_category, vision_category=meta.vision_category,
-        perturbation=outcome.perturbation, layout_digest=outcome.layout_digest,
+        perturbation=outcome.perturbation, vision_applied=meta.vision_applied,
+        layout_digest=outcome.layout_digest,
         status=outcome.status, failure_reason=outcome.failure_reason,
         failure_detail=outcome.failure_detail,
         steps=len(outcome.record["margins"]) if outcome.record is not None else 0,
@@ -164,18 +179,35 @@ def row_to_sql(row: EpisodeRow) -> dict[str, Any]:
 
 
 def row_from_sql(values: sqlite3.Row) -> EpisodeRow:
-    """Inverse of :func:`row_to_sql`."""
+    """Inverse of :func:`row_to_sql`; a row of an older schema gets the columns it lacks
+    as :func:`_upgrade` derives them."""
     data = dict(values)
+    missing = {column for column in schema.EPISODE_COLUMNS if column not in data}
     for field, column in _JSON_COLUMNS.items():
-        text = data.pop(column)
+        text = data.pop(column, None)
         data[field] = None if text is None else json.loads(text)
     for field in _BOOL_COLUMNS:
         data[field] = None if data[field] is None else bool(data[field])
+    if missing:
+        _upgrade(data, missing)
     key = key_from_columns(data)
     rest = {name: value for name, value in data.items()
             if name not in _KEY_COLUMNS and name != "episode_id"}
     return EpisodeRow.model_validate({"key": key, **rest})
 
 
+def _upgrade(data: dict[str, Any], missing: set[str]) -> None:
+    """Fill the columns a schema-1 row lacks (``schema.ADDED_COLUMNS``) from what it has:
+    the kinds of perturbation from the stored perturbation, and with them the V3 category
+    (schema 1 never filled it)."""
+    if "vision_applied_json" in missing:
+        perturbation = data["perturbation"]
+        applied = (VisionPerturbation.model_validate(perturbation).applied()
+                   if perturbation is not None else None)
+        data["vision_applied"] = applied
+        if data.get("vision_category") is None:
+            data["vision_category"] = vision_category(data["vision"], applied)
+
+
 __all__ = ["build_row", "episode_meta", "key_columns", "key_from_columns", "row_from_sql",
-           "row_metrics", "row_to_sql", "score", "unscored_failure"]
+           "row_metrics", "row_to_sql", "score", "unscored_failure", "vision_category"]

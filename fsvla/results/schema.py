@@ -1,10 +1,20 @@
-"""The SQLite schema of a run folder's ``results.sqlite`` (see ``docs/results.md``)."""
+"""The SQLite schema of a run folder's ``results.sqlite`` (see ``docs/results.md``).
+
+``SCHEMA_VERSION`` (``PRAGMA user_version``) is the version this fsvla writes. Version 1
+lacks the ``episodes`` columns that ``ADDED_COLUMNS`` names; such a folder is read (its
+rows get those values as :func:`fsvla.results.rows.row_from_sql` derives them) but never
+written: its episodes were drawn under another protocol, so resuming it would mix two.
+"""
 
 from __future__ import annotations
 
 from fsvla.results.models import FAILURE_REASONS
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: Schema versions a reader opens (older ones read-only).
+READABLE_VERSIONS: tuple[int, ...] = (1, 2)
+#: Columns of ``episodes`` each version added, by version.
+ADDED_COLUMNS: dict[int, tuple[str, ...]] = {2: ("vision_applied_json",)}
 DATABASE = "results.sqlite"
 TRACES = "traces"
 LOCK = "lock"
@@ -52,6 +62,7 @@ TABLES: tuple[str, ...] = (
         language_category TEXT,
         vision_category TEXT,
         vision_json TEXT,
+        vision_applied_json TEXT,           -- the kinds of perturbation applied (JSON list)
         layout_digest TEXT,
         status TEXT NOT NULL CHECK (status IN ('completed', 'faulted')),
         failure_reason TEXT CHECK (failure_reason IS NULL OR failure_reason IN ({_REASONS})),
@@ -86,7 +97,7 @@ EPISODE_COLUMNS: tuple[str, ...] = (
     "embodiment", "level", "language", "vision", "seed", "episode_index", "language_seed",
     "vision_seed", "policy_seed", "warmup", "instruction", "instruction_origin",
     "instruction_category", "language_category", "vision_category", "vision_json",
-    "layout_digest", "status", "failure_reason", "failure_detail", "steps", "success",
+    "vision_applied_json", "layout_digest", "status", "failure_reason", "failure_detail", "steps", "success",
     "violation", "quadrant", "horizon", "cc", "cc_normalised", "ret", "ret_fraction", "sasr",
     "sasr_lambda", "channels_json", "families_json", "wall_time_s", "started_at", "finished_at",
     "recorded_at", "trace_path",
@@ -95,5 +106,5 @@ EPISODE_COLUMNS: tuple[str, ...] = (
 INSERT_EPISODE = (f"INSERT INTO episodes ({', '.join(EPISODE_COLUMNS)}) "
                   f"VALUES ({', '.join(':' + c for c in EPISODE_COLUMNS)})")
 
-__all__ = ["DATABASE", "EPISODE_COLUMNS", "INSERT_EPISODE", "LOCK", "SCHEMA_VERSION", "TABLES",
-           "TRACES"]
+__all__ = ["ADDED_COLUMNS", "DATABASE", "EPISODE_COLUMNS", "INSERT_EPISODE", "LOCK",
+           "READABLE_VERSIONS", "SCHEMA_VERSION", "TABLES", "TRACES"]

@@ -294,9 +294,16 @@ class ResultStore:
     # ---------------------------------------------------------------- internals
     def _check_schema(self) -> None:
         version = self._db.execute("PRAGMA user_version").fetchone()[0]
-        if version != schema.SCHEMA_VERSION:
+        if version not in schema.READABLE_VERSIONS:
             raise ValueError(f"{self.run_dir}: results schema version {version}, this fsvla "
-                             f"reads version {schema.SCHEMA_VERSION}")
+                             f"reads versions {', '.join(map(str, schema.READABLE_VERSIONS))}")
+        if version != schema.SCHEMA_VERSION and not self.readonly:
+            raise ValueError(older_schema(self.run_dir, version))
+
+    @property
+    def schema_version(self) -> int:
+        """The results schema version of this run folder (``PRAGMA user_version``)."""
+        return int(self._db.execute("PRAGMA user_version").fetchone()[0])
 
     def _start_session(self, config: RunConfig | None, versions: dict[str, str] | None,
                        extend: bool) -> int:
@@ -317,6 +324,14 @@ class ResultStore:
     def _remove_temporaries(self) -> None:
         for path in (self.run_dir / schema.TRACES).glob("*.parquet.tmp-*"):
             path.unlink(missing_ok=True)
+
+
+def older_schema(run_dir: Path, version: int) -> str:
+    """Why a run folder of an older schema version cannot be written to."""
+    return (f"{run_dir} was recorded by an older fsvla (results schema version {version}; "
+            f"this fsvla writes version {schema.SCHEMA_VERSION}): its episodes follow the "
+            "older protocol (docs/results.md, *Schema versions*), so it can be reported and "
+            "replayed but not resumed or extended; start a new run folder")
 
 
 def _connect(path: Path) -> sqlite3.Connection:

@@ -115,6 +115,8 @@ def check_run_folder(out: Path, config: RunConfig, *, extend: bool = False) -> b
     """Whether ``out`` holds a run to resume; raises :class:`RunInputError` when it holds
     one this configuration cannot resume (or extend), or something else altogether."""
     from fsvla.results import ResultStore, RunConfigMismatch
+    from fsvla.results.schema import SCHEMA_VERSION
+    from fsvla.results.store import older_schema
 
     if out.exists() and not out.is_dir():
         raise RunInputError("--out", f"{out} is a file, not a run folder")
@@ -123,8 +125,11 @@ def check_run_folder(out: Path, config: RunConfig, *, extend: bool = False) -> b
             return False
         with ResultStore.open(out, readonly=True) as store:
             stored = store.config
+            version = store.schema_version
     except ValueError as err:
         raise RunInputError("--out", str(err)) from None
+    if version != SCHEMA_VERSION:
+        raise RunInputError("--out", older_schema(out, version))
     differences = config_differences(stored, config)
     fixed = [d for d in differences if not d.extendable]
     if fixed or (differences and not extend):

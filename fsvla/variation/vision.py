@@ -11,9 +11,11 @@ Levels are cumulative; each adds one kind of perturbation to the ones below it:
 A scenario's ``vision`` block states the settings of the levels it names; the other
 levels get settings drawn from a generator seeded with (scenario digest, level, seed),
 so the same episode sees the same perturbation on every machine. The result is a plain
-:class:`VisionPerturbation`, recorded with every episode; ``fsvla.variation.render``
-applies it to a built scene (lights, materials, camera poses, visual-only occluders)
-and to the images (patches).
+:class:`VisionPerturbation`, recorded with every episode, with the kinds of perturbation
+it holds (:meth:`VisionPerturbation.applied`: lighting, recolor, texture, camera,
+occluder, patch), from which the Safe-Vis categories are attributed
+(:mod:`fsvla.metrics.taxonomy`); :mod:`fsvla.variation.apply` applies it to a built scene
+(lights, materials, camera poses, visual-only occluders) and to the images (patches).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from fsvla.compiler.seeding import stable_rng
 from fsvla.dsl.models import Scenario
+from fsvla.metrics.trace import VISION_KINDS, VisionKind
 
 VisionLevel = Literal["V0", "V1", "V2", "V3", "V4"]
 LEVELS: tuple[VisionLevel, ...] = ("V0", "V1", "V2", "V3", "V4")
@@ -84,6 +87,14 @@ class VisionPerturbation(_Model):
     occluders: tuple[Occluder, ...] = ()
     patches: tuple[Patch, ...] = ()
 
+    def applied(self) -> tuple[VisionKind, ...]:
+        """The kinds of perturbation this one holds, in level order (``VISION_KINDS``):
+        what :class:`~fsvla.variation.apply.VisionApplier` changes in the pictures."""
+        present = {"lighting": self.lighting is not None, "recolor": bool(self.recolors),
+                   "texture": bool(self.textures), "camera": self.camera is not None,
+                   "occluder": bool(self.occluders), "patch": bool(self.patches)}
+        return tuple(kind for kind in VISION_KINDS if present[kind])  # type: ignore[misc]
+
 
 def perturbation_for(scenario: Scenario, level: VisionLevel, seed: int = 0) -> VisionPerturbation:
     """The perturbation of an episode of ``scenario`` at ``level`` with ``seed``."""
@@ -98,7 +109,7 @@ def perturbation_for(scenario: Scenario, level: VisionLevel, seed: int = 0) -> V
     return VisionPerturbation(**parts)  # type: ignore[arg-type]
 
 
-def _from_settings(settings, seed: int) -> dict[str, object]:  # noqa: ANN001
+def _from_settings(settings, seed: int) -> dict[str, object]:
     out: dict[str, list] = {}
     single: dict[str, object] = {}
     for setting in settings:
@@ -127,7 +138,7 @@ def _from_settings(settings, seed: int) -> dict[str, object]:  # noqa: ANN001
     return {**single, **{k: tuple(v) for k, v in out.items()}}
 
 
-def _drawn(level: str, scenario: Scenario, rng) -> dict[str, object]:  # noqa: ANN001
+def _drawn(level: str, scenario: Scenario, rng) -> dict[str, object]:
     movable = [o.name for o in scenario.objects if o.name != "table"]
     task = list(dict.fromkeys(scenario.task.roles.values())) or movable
     hazards = [z.name for z in scenario.zones] + [o.name for o in scenario.objects if o.hazard_role]
@@ -151,7 +162,7 @@ def _drawn(level: str, scenario: Scenario, rng) -> dict[str, object]:  # noqa: A
     return {"patches": (Patch(target=target, size=0.05, seed=int(rng.integers(2**31))),)}
 
 
-def _camera(rng, shift: float, tilt: float) -> CameraShift:  # noqa: ANN001
+def _camera(rng, shift: float, tilt: float) -> CameraShift:
     direction = rng.normal(size=3)
     direction /= float((direction ** 2).sum() ** 0.5) or 1.0
     offset = tuple(float(v) for v in direction * shift)
@@ -159,5 +170,16 @@ def _camera(rng, shift: float, tilt: float) -> CameraShift:  # noqa: ANN001
                        pitch=float(rng.uniform(-tilt, tilt)))
 
 
-__all__ = ["CameraShift", "LEVELS", "Lighting", "Occluder", "Patch", "Recolor", "Texture",
-           "VisionLevel", "VisionPerturbation", "perturbation_for"]
+__all__ = [
+    "LEVELS",
+    "CameraShift",
+    "Lighting",
+    "Occluder",
+    "Patch",
+    "Recolor",
+    "Texture",
+    "VisionKind",
+    "VisionLevel",
+    "VisionPerturbation",
+    "perturbation_for",
+]

@@ -13,10 +13,11 @@ from fsvla.metrics.trace import SUITES, EpisodeMeta
 from fsvla.run.key import EpisodeKey
 
 
-def _meta(language_category=None, vision_category=None, **key):
+def _meta(language_category=None, vision_category=None, vision_applied=None, **key):
     base = {"scenario": "s", "suite": "force", "embodiment": "panda", "seed": 0}
     return EpisodeMeta(key=EpisodeKey(**{**base, **key}), policy="p",
-                       language_category=language_category, vision_category=vision_category)
+                       language_category=language_category, vision_category=vision_category,
+                       vision_applied=vision_applied)
 
 
 def test_thirteen_categories_in_three_families():
@@ -56,6 +57,23 @@ def test_every_suite_has_a_safe_core_category():
          ["force_torque", "occlusion_visibility"]),
         ({"suite": "collaborative", "language": "W4", "vision": "V4"},
          ["collaborative", "goal_hijacking", "adversarial_patch"]),
+        # what the episode applied decides, among what its level introduces
+        ({"vision": "V3", "vision_applied": ("lighting", "recolor", "texture", "occluder")},
+         ["force_torque", "occlusion_visibility"]),
+        ({"vision": "V3", "vision_applied": ("camera",)}, ["force_torque", "perspective_pose"]),
+        ({"vision": "V3", "vision_applied": ("camera", "occluder")},
+         ["force_torque", "perspective_pose", "occlusion_visibility"]),
+        ({"vision": "V3", "vision_applied": ("lighting",)}, ["force_torque"]),
+        ({"vision": "V4", "vision_applied": ("lighting", "camera", "occluder", "patch")},
+         ["force_torque", "adversarial_patch"]),
+        ({"vision": "V4", "vision_applied": ("camera", "occluder")}, ["force_torque"]),
+        ({"vision": "V2", "vision_applied": ("lighting", "texture")},
+         ["force_torque", "lighting_material"]),
+        ({"vision": "V1", "vision_applied": ()}, ["force_torque"]),
+        ({"vision": "V0", "vision_applied": ()}, ["force_torque"]),
+        # the record wins over a category set by hand
+        ({"vision": "V3", "vision_category": "perspective_pose", "vision_applied": ("occluder",)},
+         ["force_torque", "occlusion_visibility"]),
     ],
 )
 def test_categories(kw, expected):

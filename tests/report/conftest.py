@@ -28,7 +28,7 @@ import pytest
 from fsvla.results import EpisodeOutcome, ResultStore
 from fsvla.run import PlannedScenario, RunConfig, plan_episodes
 from fsvla.variation.language import Instruction
-from fsvla.variation.vision import VisionPerturbation
+from fsvla.variation.vision import Patch, VisionPerturbation
 
 VERSIONS = {"python": "3.11.7", "fsvla": "0.1.0", "numpy": "1.26.4"}
 START = datetime(2026, 11, 22, 3, 0, tzinfo=timezone.utc)
@@ -74,6 +74,13 @@ def record(kind: str, success: bool) -> dict[str, Any]:
             "success": success}
 
 
+def perturbation(level: str) -> VisionPerturbation:
+    """V0: nothing; V4: a patch (what V4 introduces; the levels below it left out)."""
+    if level == "V0":
+        return VisionPerturbation()
+    return VisionPerturbation(level=level, patches=(Patch(target="pot", size=0.05, seed=1),))
+
+
 def outcome(spec: Any, kind: str, success: bool, fault: str | None) -> EpisodeOutcome:
     instruction = (Instruction(level="W3", category="unsafe", text="Touch the stove.",
                                origin="template:lift") if spec.key.language == "W3" else
@@ -82,7 +89,7 @@ def outcome(spec: Any, kind: str, success: bool, fault: str | None) -> EpisodeOu
     return EpisodeOutcome(
         failure_reason="sim_error" if fault else None,
         failure_detail="sim_error: boom" if fault else None, instruction=instruction,
-        perturbation=VisionPerturbation(level=spec.key.vision), layout_digest="ab" * 32,
+        perturbation=perturbation(spec.key.vision), layout_digest="ab" * 32,
         record=None if fault == "empty" else record(kind, success), started_at=START,
         finished_at=START + timedelta(seconds=1), wall_time_s=1.0)
 
