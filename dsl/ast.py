@@ -277,6 +277,7 @@ class VariantLevel:
     level: Name
     rules: tuple[Rule, ...]
     span: Span
+    none: Name | None = None  # `L0: none`: the level's rules are none at all
 
 
 @node

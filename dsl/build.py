@@ -192,6 +192,8 @@ class AstBuilder:
 
     def variant_level(self, span, children):
         level, *rules = children
+        if len(rules) == 1 and isinstance(rules[0], str):  # the NONE token of `L0: none`
+            return ast.VariantLevel(self._name(level), (), span, self._name(rules[0]))
         return ast.VariantLevel(self._name(level), tuple(rules), span)
 
     def variants(self, span, children):

@@ -226,7 +226,8 @@ class Scenario(_Model):
     limits: tuple[LimitSpec, ...] = ()
     requirements: tuple[Requirement, ...] = ()
     success: Success
-    variants: dict[Literal["L1", "L2"], tuple[VariantRule, ...]] = Field(default_factory=dict)
+    # L0: the nuisance jitter when written (() for `L0: none`); absent, the default one.
+    variants: dict[Literal["L0", "L1", "L2"], tuple[VariantRule, ...]] = Field(default_factory=dict)
     language: dict[Literal["W1", "W2", "W3", "W4"], tuple[LanguageVariant, ...]] = Field(
         default_factory=dict)
     vision: dict[Literal["V1", "V2", "V3", "V4"], tuple[VisionSetting, ...]] = Field(

@@ -20,10 +20,13 @@ from .errors import Infeasibility, VariantError, describe_rule, lowering_diagnos
 from .feasibility import CLUTTER_CLEARANCE, CONTACT_TOLERANCE, REACH_MARGIN
 from .generate import (
     NEAR_DISTANCE,
+    NUISANCE_DISTANCE,
+    NUISANCE_YAW,
     Generator,
     cached_build_asset,
     cached_build_zone_marker,
     load_spec,
+    nuisance_rules,
     rng_for,
     rules_of,
 )
@@ -75,6 +78,6 @@ def generate_variant(
 
 __all__ = [
     "CLUTTER_CLEARANCE", "CLUTTER_PALETTE", "CONTACT_TOLERANCE", "LEVELS", "NEAR_DISTANCE",
-    "REACH_MARGIN", "Infeasibility", "Variant", "VariantError", "describe_rule", "generate_variant",
-    "lowering_diagnostics", "rules_of",
+    "NUISANCE_DISTANCE", "NUISANCE_YAW", "REACH_MARGIN", "Infeasibility", "Variant", "VariantError",
+    "describe_rule", "generate_variant", "lowering_diagnostics", "nuisance_rules", "rules_of",
 ]

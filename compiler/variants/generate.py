@@ -1,7 +1,9 @@
 """``generate_variant``: a seeded, feasibility-checked layout of a scenario at L0, L1 or L2.
 
-L0 is the canonical layout. L1 applies the scenario's ``L1`` rules; L2 applies the L1
-rules and then the ``L2`` rules (cumulative). Each sample draws every rule in order —
+L0 is the canonical layout with a small nuisance jitter: the scenario's ``L0`` jitters when
+it writes them (none for ``L0: none``), else every task object jittered by
+``NUISANCE_DISTANCE`` and ``NUISANCE_YAW``. L1 applies the scenario's ``L1`` rules; L2
+applies the L1 rules and then the ``L2`` rules (cumulative; the L0 nuisance is L0's own). Each sample draws every rule in order —
 jitters, approaches and clutter move or add things; tightens and couples change the
 limits and requirements — and is accepted when it passes every check of
 :mod:`.feasibility`. Static checks run first and fail without sampling. The random
@@ -62,6 +64,10 @@ CLUTTER_TRIES = 20
 PACKING_DENSITY = 0.5
 #: Grid step (m) for measuring free area.
 AREA_STEP = 0.01
+#: L0's default nuisance: each task object moves within this radius (m) and turns within
+#: ± this angle (rad), as RoboTwin randomises object poses in its clean setting.
+NUISANCE_DISTANCE = 0.01
+NUISANCE_YAW = math.radians(5.0)
 
 LeveledRule = tuple[Level, VariantRule]
 
@@ -116,8 +122,23 @@ def _freeze(params: Mapping[str, ParamValue]) -> tuple | None:
 # --- rules -----------------------------------------------------------------------------------
 
 
+def nuisance_rules(scenario: Scenario) -> tuple[VariantRule, ...]:
+    """L0's nuisance jitter: the scenario's ``L0`` rules when it writes them (``L0: none``
+    gives none), else each task object within ``NUISANCE_DISTANCE`` and ``NUISANCE_YAW``,
+    on the line of its ``task``."""
+    if "L0" in scenario.variants:
+        return scenario.variants["L0"]
+    objects = [name for name in dict.fromkeys(scenario.task.roles.values())
+               if name != "table" and scenario.object(name) is not None]
+    return tuple(Jitter(target=name, distance=NUISANCE_DISTANCE, yaw=NUISANCE_YAW,
+                        source=scenario.task.source) for name in objects)
+
+
 def rules_of(scenario: Scenario, level: Level) -> list[LeveledRule]:
-    """The rules a level applies, in order: none at L0, L1's at L1, L1's then L2's at L2."""
+    """The rules a level applies, in order: the nuisance jitter at L0, L1's at L1, L1's
+    then L2's at L2."""
+    if level == "L0":
+        return [("L0", rule) for rule in nuisance_rules(scenario)]
     levels: tuple[Level, ...] = ("L1", "L2")[:("L0", "L1", "L2").index(level)]
     return [(lvl, rule) for lvl in levels for rule in scenario.variants.get(lvl, ())]
 
@@ -238,10 +259,11 @@ class Generator(SafeStart):
                lower: Callable[[Scenario], SceneSpec]) -> tuple[Scenario, SceneSpec, int]:
         """The first feasible sample, lowered by ``lower``; raises :class:`VariantError`."""
         self.start_checks()
-        if not self.samples_needed:
+        if not self.samples_needed or self.level == "L0":
             draw, rejection = Draw(), self.checker.check(Draw())
-            if rejection is not None:
+            if rejection is not None:  # L0: the canonical layout first, on its own lines
                 raise VariantError(self.canonical_failure(rejection))
+        if not self.samples_needed:
             scenario = self.layout.apply(draw, self.varied)
             return scenario, lower(scenario), 0
         self.static_checks()
@@ -413,7 +435,13 @@ class Generator(SafeStart):
                    f"most often: {cause} ({count} of {n})"),
             remedies=tuple(dict.fromkeys((*self._rule_remedies(rule, tally.examples.get(index)),
                                           *self._other_remedies(index, tally),
+                                          *self._nuisance_remedy(),
                                           f"raise the budget (now {self.budget} samples)"))))
+
+    def _nuisance_remedy(self) -> tuple[str, ...]:
+        if self.level != "L0":
+            return ()
+        return ("write `L0: none` under `variants` to keep the canonical layout exactly",)
 
     def _other_remedies(self, blamed: int, tally: _Tally) -> tuple[str, ...]:
         """The first remedy of each other rule that half the rejections or more involve."""
@@ -510,5 +538,6 @@ def load_spec(scenario: Scenario, embodiment: EmbodimentSpec | None) -> Embodime
                             scenario.source) from err
 
 
-__all__ = ["CLUTTER_TRIES", "NEAR_DISTANCE", "PACKING_DENSITY", "Generator", "cached_build_asset",
-           "cached_build_zone_marker", "load_spec", "rng_for", "rules_of", "vary_limits"]
+__all__ = ["CLUTTER_TRIES", "NEAR_DISTANCE", "NUISANCE_DISTANCE", "NUISANCE_YAW", "PACKING_DENSITY",
+           "Generator", "cached_build_asset", "cached_build_zone_marker", "load_spec",
+           "nuisance_rules", "rng_for", "rules_of", "vary_limits"]

@@ -1,5 +1,5 @@
 """The ``variants`` block: structure levels L1 and L2 and their rules (``jitter``, ``approach``,
-``clutter``, ``tighten``, ``couple``)."""
+``clutter``, ``tighten``, ``couple``), and L0's nuisance jitter (``jitter`` rules, or ``none``)."""
 
 from __future__ import annotations
 
@@ -14,14 +14,30 @@ class VariantChecker(Part):
     def variants(self) -> dict:
         out: dict = {}
         for level_name, level in self.scope.merged.variants.items():
-            if level_name not in ("L1", "L2"):
+            if level_name not in ("L0", "L1", "L2"):
                 self.sink.error("FSV501", f"unknown structure level `{level_name}`", level.level.span,
-                                "not L1 or L2", help="L0 is the canonical layout as declared; "
-                                "write rules for `L1` (placement variation) and `L2` (harder layouts)")
+                                "not L0, L1 or L2", help="write rules for `L1` (placement variation) "
+                                "and `L2` (harder layouts); `L0` takes only its nuisance `jitter`, or `none`")
+                continue
+            if not self._fits_level(level_name, level):
                 continue
             rules = [self._rule(rule) for rule in level.rules]
             out[level_name] = tuple(r for r in rules if r is not None)
         return out
+
+    def _fits_level(self, level_name: str, level: ast.VariantLevel) -> bool:
+        """``none`` only at L0, and L0 only ``jitter`` (FSV506)."""
+        if level.none is not None and level_name != "L0":
+            self.sink.error("FSV506", "`none` is only for `L0`", level.none.span, f"not an {level_name} rule",
+                            help=f"leave `{level_name}` out to vary nothing there")
+            return False
+        wrong = next((rule for rule in level.rules if level_name == "L0" and rule.kind.value != "jitter"), None)
+        if wrong is not None:
+            self.sink.error("FSV506", f"`{wrong.kind.value}` is not an L0 rule", wrong.kind.span,
+                            "L0 takes only `jitter`",
+                            help="L0 is the canonical layout with a nuisance jitter; move it to `L1` or `L2`")
+            return False
+        return True
 
     def _rule(self, rule: ast.Rule):
         check = {"jitter": self._jitter, "approach": self._approach, "clutter": self._clutter,

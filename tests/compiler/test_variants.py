@@ -15,12 +15,14 @@ import numpy as np
 import pytest
 from fsvla.compiler.collision import min_distance, pieces_of
 from fsvla.compiler.pose import pose_matrix, quat_yaw
-from fsvla.compiler.scene import LoweringError, SceneBody, SceneSpec
+from fsvla.compiler.scene import LoweringError, SceneBody, SceneSpec, lower_scene
 from fsvla.compiler.variants import (
     CLUTTER_CLEARANCE,
     CLUTTER_PALETTE,
     CONTACT_TOLERANCE,
     NEAR_DISTANCE,
+    NUISANCE_DISTANCE,
+    NUISANCE_YAW,
     REACH_MARGIN,
     Variant,
     VariantError,
@@ -101,11 +103,73 @@ def test_layout_does_not_depend_on_the_process(builtin: dict[str, Scenario]) -> 
     assert out == hashlib.sha256(here.encode()).hexdigest()
 
 
-def test_l0_is_the_canonical_layout(builtin: dict[str, Scenario]) -> None:
-    scenario = builtin["pick_cup_near_edge"]
+def test_l0_none_is_the_canonical_layout(builtin: dict[str, Scenario]) -> None:
+    written = builtin["pick_cup_near_edge"]
+    scenario = written.model_copy(update={"variants": {**written.variants, "L0": ()}})
     variant = generate_variant(scenario, "L0", 4)
     assert variant.scenario == scenario and variant.samples == 0
     assert (variant.scene.level, variant.scene.seed) == ("L0", 4)
+
+
+def _pose_changes(variant: Variant, canonical: SceneSpec) -> dict[str, tuple[float, float]]:
+    """Each body's move (m) and turn (rad) from the canonical layout."""
+    out = {}
+    for body in variant.scene.bodies:
+        before = canonical.body(body.name)
+        turn = quat_yaw(body.pose.quaternion) - quat_yaw(before.pose.quaternion)
+        out[body.name] = (math.dist(body.pose.position, before.pose.position),
+                          abs((turn + math.pi) % (2 * math.pi) - math.pi))
+    return out
+
+
+@pytest.mark.parametrize("path", CONCRETE, ids=lambda p: p.stem)
+def test_l0_differs_from_the_canonical_layout_only_within_the_nuisance(
+        path: Path, builtin: dict[str, Scenario]) -> None:
+    scenario = builtin[path.stem]
+    canonical = lower_scene(scenario, level="L0", seed=0, allowed_roots=[SCENARIOS])
+    task = set(scenario.task.roles.values())
+    layouts = set()
+    for seed in SEEDS:
+        variant = generate_variant(scenario, "L0", seed, allowed_roots=[SCENARIOS])
+        layouts.add(variant.scene.model_dump_json(exclude={"seed"}))
+        for name, (move, turn) in _pose_changes(variant, canonical).items():
+            if name in task:
+                assert move <= NUISANCE_DISTANCE + 1e-9, (seed, name, move)
+                assert turn <= NUISANCE_YAW + 1e-9, (seed, name, turn)
+            elif not _follows(scenario, name, task):  # what stands on a task object moves with it
+                assert (move, turn) == (0.0, 0.0), (seed, name)
+        assert variant.scene.zones == canonical.zones
+    assert len(layouts) == len(SEEDS)  # each seed its own nuisance
+
+
+def _follows(scenario: Scenario, name: str, task: set[str]) -> bool:
+    """Whether ``name`` is placed on or relative to a task object, transitively."""
+    spec = scenario.object(name)
+    while spec is not None:
+        relation = spec.placement.relation
+        if spec.placement.support in task or (relation is not None and relation.anchor in task):
+            return True
+        spec = scenario.object(spec.placement.support)
+    return False
+
+
+def test_an_l0_jitter_replaces_the_default_nuisance() -> None:
+    scenario = _loads(POT_AND_STOVE + "    L0: jitter stove 5 mm\n")
+    assert [(r.target, r.distance) for _, r in rules_of(scenario, "L0")] == [("stove", 0.005)]
+    for seed in SEEDS:
+        variant = generate_variant(scenario, "L0", seed)
+        assert np.allclose(_xy(variant, "pot"), (0.0, 0.0))
+        assert 0.0 < np.linalg.norm(_xy(variant, "stove") - (0.30, 0.0)) <= 0.005 + 1e-12
+    default = _loads(POT_AND_STOVE + "    L1: jitter stove 1 cm\n")
+    assert [(r.target, r.distance, r.yaw, r.source.line) for _, r in rules_of(default, "L0")] == [
+        ("pot", NUISANCE_DISTANCE, NUISANCE_YAW, 3)]  # the task's object, on the task's line
+
+
+def test_an_infeasible_canonical_layout_is_diagnosed_at_l0_before_any_nuisance() -> None:
+    text = POT_AND_STOVE.replace("at (30 cm, 0) on table", "at (12 cm, 0) on table")
+    with pytest.raises(VariantError) as raised:
+        generate_variant(_loads(text + "    L1: jitter pot 1 cm\n"), "L0")
+    assert raised.value.failure.code == "FSV603"
 
 
 # --- feasibility, checked independently ---------------------------------------------------------

@@ -149,6 +149,13 @@ SEMANTIC_CASES = [
      "FSV405", 9, 10, "nothing called `ghost` to remove", None),
     ("FSV501-unknown-level", add("variants", "  L3: jitter pot 2 cm"),
      "FSV501", 10, 5, "unknown structure level `L3`", None),
+    ("FSV506-approach-at-L0", add("hazard h: heat_zone(radius=5 cm) at (30 cm, 0)",
+                                  "  keep pot outside 3 cm warn 1 cm", "variants",
+                                  "  L0: jitter pot 5 mm, approach h to pot by 1 cm"),
+     "FSV506", 12, 26, "`approach` is not an L0 rule",
+     "L0 is the canonical layout with a nuisance jitter; move it to `L1` or `L2`"),
+    ("FSV506-none-above-L0", add("variants", "  L2: none"),
+     "FSV506", 10, 9, "`none` is only for `L0`", "leave `L2` out to vary nothing there"),
     ("FSV502-approach-non-hazard", add("variants", "  L2: approach pot to pot by 2 cm"),
      "FSV502", 10, 18, "`approach` moves a hazard, and `pot` is not one", None),
     ("FSV502-tighten-unknown", add("variants", "  L2: tighten nothing to 2 N"),
@@ -212,7 +219,7 @@ def test_every_listed_code_is_exercised() -> None:
     wanted = {"FSV101", "FSV102", "FSV103", "FSV104", "FSV105", "FSV106", "FSV107", "FSV108", "FSV109",
               "FSV110", "FSV111", "FSV112", "FSV201", "FSV203", "FSV204", "FSV205", "FSV206", "FSV209",
               "FSV210", "FSV212", "FSV301", "FSV302", "FSV303", "FSV304", "FSV306", "FSV307", "FSV403",
-              "FSV404", "FSV405", "FSV501", "FSV502", "FSV503", "FSV504", "FSV505"}
+              "FSV404", "FSV405", "FSV501", "FSV502", "FSV503", "FSV504", "FSV505", "FSV506"}
     assert wanted <= {case[2] for case in SEMANTIC_CASES}
 
 

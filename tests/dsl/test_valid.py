@@ -190,6 +190,18 @@ def test_variants(ir: models.Scenario) -> None:
     assert (couple.rule, couple.requirement, couple.within) == ("couple", "first", 2.0)
 
 
+@pytest.mark.parametrize(("line", "expected"), [
+    ("L0: none", ()),
+    ("L0: jitter mug 5 mm yaw 2 deg", (("mug", 0.005, math.radians(2)),)),
+])
+def test_the_l0_nuisance_jitter_is_written_or_turned_off(line: str, expected: tuple) -> None:
+    text = PROGRAM.replace("  variants\n", f"  variants\n    {line}\n")
+    scenario = ScenarioLoader().loads(text, "v.fsv").scenario
+    assert [(r.target, pytest.approx(r.distance), pytest.approx(r.yaw))
+            for r in scenario.variants["L0"]] == list(expected)
+    assert [r.rule for r in scenario.variants["L1"]] == ["jitter", "jitter"]
+
+
 def test_language_and_vision(ir: models.Scenario) -> None:
     assert [(v.text, v.category) for v in ir.language["W1"]] == [
         ("Put the mug on the tray.", "paraphrase"), ("Place the mug onto the tray.", "paraphrase")]
