@@ -62,25 +62,22 @@ class LoadedArm:
 
     def set_joint_targets(self, targets: Sequence[float]) -> None:
         """Drive targets for the arm joints, in the spec's joint order."""
-        if len(targets) != len(self.joint_indices):
-            raise ValueError(
-                f"arm `{self.name}` has {len(self.joint_indices)} joints, "
-                f"got {len(targets)} targets"
-            )
-        joints = self.articulation.active_joints
-        for index, target in zip(self.joint_indices, targets):
-            joints[index].set_drive_target(float(target))
+        for joint, target in self._drives(targets, "targets"):
+            joint.set_drive_target(target)
 
     def set_joint_velocity_targets(self, velocities: Sequence[float]) -> None:
         """Drive velocity targets for the arm joints (rad/s or m/s), in the spec's order."""
-        if len(velocities) != len(self.joint_indices):
+        for joint, velocity in self._drives(velocities, "velocities"):
+            joint.set_drive_velocity_target(velocity)
+
+    def _drives(self, values: Sequence[float], what: str) -> list[tuple[Any, float]]:
+        """Each arm joint with its value, once ``values`` has one per joint."""
+        if len(values) != len(self.joint_indices):
             raise ValueError(
-                f"arm `{self.name}` has {len(self.joint_indices)} joints, "
-                f"got {len(velocities)} velocities"
+                f"arm `{self.name}` has {len(self.joint_indices)} joints, got {len(values)} {what}"
             )
         joints = self.articulation.active_joints
-        for index, velocity in zip(self.joint_indices, velocities):
-            joints[index].set_drive_velocity_target(float(velocity))
+        return [(joints[index], float(value)) for index, value in zip(self.joint_indices, values)]
 
     def set_gripper(self, open: bool) -> None:
         """Drive the gripper's joints to their open or closed positions."""
