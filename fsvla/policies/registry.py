@@ -6,7 +6,9 @@ Accepted forms:
 - ``module:Class`` (or ``module:factory``): any importable class or callable that returns
   an object with ``reset(episode)`` and ``act(observation)``; ``path/to/file.py:Class``
   imports a file;
-- ``ws://host:port``: a policy server speaking the openpi websocket protocol.
+- ``ws://host:port``: a policy server speaking the openpi websocket protocol, with the
+  keys and action space of a profile (``droid``, ``libero``, ``aloha``, ``fsvla`` or a TOML
+  file: :mod:`fsvla.policies.profile`).
 """
 
 from __future__ import annotations
@@ -48,14 +50,21 @@ class PolicyLoadError(ValueError):
     """A ``--policy`` value that names nothing usable."""
 
 
-def load_policy(spec: str) -> Policy:
-    """The policy ``spec`` names (see the module doc); raises :class:`PolicyLoadError`."""
+def load_policy(spec: str, profile: str | None = None) -> Policy:
+    """The policy ``spec`` names (see the module doc), a policy server speaking
+    ``profile`` (a built-in profile's name or a TOML file; None: fsvla's own keys);
+    raises :class:`PolicyLoadError`."""
+    remote = spec.startswith(("ws://", "wss://"))
+    if profile is not None and not remote:
+        raise PolicyLoadError(f"--policy-profile {profile}: profiles map the keys of a policy "
+                              f"server (--policy ws://host:port), and --policy {spec!r} is none")
     if spec in BUILTIN:
         return BUILTIN[spec]()
-    if spec.startswith(("ws://", "wss://")):
+    if remote:
+        from .profile import load_profile
         from .remote import RemotePolicy
 
-        return RemotePolicy(spec)
+        return RemotePolicy(spec, profile=load_profile(profile) if profile else None)
     if ":" not in spec:
         hint = did_you_mean(spec, BUILTIN)
         raise PolicyLoadError(f"--policy {spec!r}: not a built-in policy, `module:Class` or "

@@ -15,6 +15,11 @@ What fsvla sends, per request::
 The episode message states the whole observation/action schema (camera names, state and
 action layout, quaternion order, gripper range), so a server can check it is talking
 to the embodiment it was trained for.
+
+That is the ``fsvla`` profile. With another profile (``droid``, ``libero``, ``aloha`` or a
+user's TOML file; :mod:`fsvla.policies.profile`) the request holds exactly the keys of
+that profile's example client and each reply's actions are decoded from its action
+space (:mod:`fsvla.policies.adapter`).
 """
 
 from __future__ import annotations
@@ -23,7 +28,9 @@ from typing import Any
 
 import numpy as np
 
+from .adapter import ProfileAdapter
 from .base import EpisodeInfo
+from .profile import Profile
 
 CONNECT_TIMEOUT = 30.0  # s
 REPLY_TIMEOUT = 120.0  # s: generous, a large VLA on a busy GPU is slow
@@ -38,12 +45,16 @@ class ConnectionLost(RuntimeError):
 
 
 class RemotePolicy:
-    """A client of one openpi-protocol policy server at ``ws://host:port``."""
+    """A client of one openpi-protocol policy server at ``ws://host:port``, speaking
+    ``profile`` (None: fsvla's own request)."""
 
-    def __init__(self, uri: str, *, reply_timeout: float = REPLY_TIMEOUT,
+    def __init__(self, uri: str, *, profile: Profile | None = None,
+                 reply_timeout: float = REPLY_TIMEOUT,
                  connect_timeout: float = CONNECT_TIMEOUT) -> None:
         self.uri = uri
         self.name = uri
+        self.profile = profile
+        self._adapter: ProfileAdapter | None = None
         self.reply_timeout = reply_timeout
         self.connect_timeout = connect_timeout
         self.server_metadata: dict[str, Any] = {}
@@ -52,6 +63,9 @@ class RemotePolicy:
         self._first = True
 
     def reset(self, episode: EpisodeInfo) -> None:
+        profile = self.profile  # a profile that cannot serve the episode fails before connecting
+        self._adapter = (ProfileAdapter(profile, episode)
+                         if profile is not None and not profile.native else None)
         if self._connection is None:
             self._connect()
         self._episode = episode
@@ -61,7 +75,8 @@ class RemotePolicy:
         from openpi_client import msgpack_numpy
         from websockets.exceptions import ConnectionClosed
 
-        request = self._request(observation)
+        adapter = self._adapter
+        request = adapter.request(observation) if adapter else self._request(observation)
         try:
             self._connection.send(msgpack_numpy.packb(request))
             reply = self._connection.recv(timeout=self.reply_timeout)
@@ -76,7 +91,8 @@ class RemotePolicy:
         if not isinstance(answer, dict) or "actions" not in answer:
             keys = ", ".join(map(str, answer)) if isinstance(answer, dict) else type(answer).__name__
             raise RuntimeError(f"{self.uri}: the reply has no 'actions' (got {keys})")
-        return np.asarray(answer["actions"])
+        actions = np.asarray(answer["actions"])
+        return adapter.actions(actions, observation) if adapter else actions
 
     def close(self) -> None:
         if self._connection is not None:
