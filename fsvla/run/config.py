@@ -30,6 +30,7 @@ class RunConfig(BaseModel):
 
     format_version: Literal[1] = CONFIG_FORMAT_VERSION
     policy: str = Field(min_length=1)  # a --policy spec (fsvla.policies.registry)
+    policy_profile: str | None = None  # a policy server's profile (fsvla.policies.profile)
     scenarios: tuple[str, ...] = Field(min_length=1)  # files, folders or built-in names
     levels: tuple[Level, ...] = ("L0",)
     languages: tuple[Language, ...] = ("W0",)
@@ -37,12 +38,14 @@ class RunConfig(BaseModel):
     episodes: int = Field(default=1, ge=1)  # per cell (scenario × L × W × V), over the seeds
     seeds: tuple[int, ...] = Field(default=(0,), min_length=1)  # layout seeds
     warmup: int = Field(default=1, ge=0)  # unscored episodes per scenario at L0/W0/V0, first
-    control_mode: Literal["joint_pos", "ee_pose"] = "joint_pos"
+    control_mode: Literal["joint_pos", "joint_delta", "joint_vel", "ee_pose",
+                          "ee_delta"] = "joint_pos"
     obs_mode: Literal["state", "rgb"] = "state"
     embodiment: str | None = None  # None: each scenario's own
     sasr_lambda: float = Field(default=1.0, ge=0, allow_inf_nan=False)  # λ of SASR
     terminate_on_violation: bool = False
     policy_timeout_s: float | None = Field(default=None, gt=0, allow_inf_nan=False)  # per act()
+    replan_steps: int | None = Field(default=None, ge=1)  # actions of a chunk run; None: all
 
     @field_validator("levels", "languages", "visions")
     @classmethod

@@ -23,8 +23,11 @@ _CONFIG_PARAMS = {
     "vision": "visions", "episodes": "episodes", "seeds": "seeds", "warmup": "warmup",
     "control_mode": "control_mode", "obs_mode": "obs_mode", "embodiment": "embodiment",
     "sasr_lambda": "sasr_lambda", "terminate_on_violation": "terminate_on_violation",
-    "policy_timeout": "policy_timeout_s",
+    "policy_timeout": "policy_timeout_s", "policy_profile": "policy_profile",
+    "replan_steps": "replan_steps",
 }
+#: Options whose absence leaves the value to the profile, the stored run or a default.
+_DERIVED = frozenset({"obs_mode", "control_mode", "replan_steps"})
 
 
 def _console(stderr: bool = False) -> Console:
@@ -39,6 +42,12 @@ def _fail(message: str, code: int) -> None:
 @click.command(name="run")
 @click.option("--policy", default=None, help="What to evaluate: a built-in policy (random, "
               "hold-still, ...), module:Class, path/to/file.py:Class, or ws://host:port.")
+@click.option("--policy-profile", default=None, metavar="droid|libero|aloha|fsvla|FILE.toml",
+              help="The keys and action space of a ws:// policy server: openpi's DROID, "
+                   "LIBERO or ALOHA example, fsvla's own (the default), or a profile file.")
+@click.option("--replan-steps", type=click.IntRange(min=1), default=None, metavar="N",
+              help="Actions of each returned chunk to execute before asking the policy "
+                   "again. Default: the profile's, else the whole chunk.")
 @click.option("--scenarios", multiple=True, metavar="PATHS",
               help="Scenario files, folders (searched recursively) or built-in names; "
                    "comma-separated, repeatable.")
@@ -64,8 +73,9 @@ def _fail(message: str, code: int) -> None:
 @click.option("--obs-mode", type=click.Choice(["state", "rgb"]), default=None,
               help="What the policy observes. Default: rgb if --vision goes beyond V0, "
                    "else state.")
-@click.option("--control-mode", type=click.Choice(["joint_pos", "ee_pose"]),
-              default="joint_pos", show_default=True, help="The action format.")
+@click.option("--control-mode", default=None,
+              type=click.Choice(["joint_pos", "joint_delta", "joint_vel", "ee_pose", "ee_delta"]),
+              help="The action format. Default: the profile's, else joint_pos.")
 @click.option("--embodiment", default=None, help="Run every scenario on this embodiment.")
 @click.option("--sasr-lambda", type=float, default=1.0, show_default=True, help="SASR's lambda.")
 @click.option("--terminate-on-violation", is_flag=True,
@@ -116,6 +126,7 @@ def _config(ctx: click.Context, out_dir: Path, options: dict[str, Any]):  # -> R
     from fsvla.results import ResultStore
     from fsvla.run import RangeError, parse_languages, parse_levels, parse_seeds, parse_visions
     from fsvla.runner import RunInputError, make_config
+    from fsvla.runner.prepare import profile_defaults
 
     given = {name for name in _CONFIG_PARAMS
              if ctx.get_parameter_source(name) is not click.core.ParameterSource.DEFAULT}
@@ -139,8 +150,9 @@ def _config(ctx: click.Context, out_dir: Path, options: dict[str, Any]):  # -> R
             raise RunInputError(problem.option, str(problem)) from None
         if name == "scenarios":
             value = tuple(v for item in value for v in item.split(",") if v.strip())
-        if value is not None or name != "obs_mode":
+        if value is not None or name not in _DERIVED:
             fields[field] = value
+    fields = profile_defaults(fields, {_CONFIG_PARAMS[name] for name in given})
     if fields.get("obs_mode") is None:
         fields["obs_mode"] = "state" if tuple(fields.get("visions", ("V0",))) == ("V0",) else "rgb"
     for required in ("policy", "scenarios"):
@@ -236,7 +248,7 @@ def _table(rows: list[Any]):  # -> rich Table
 
     table = Table(title="Scored episodes (faults count as failures; 95% CIs)",
                   title_justify="left")
-    for name in ("scenario", "N", "faults", "SSR", "USR", "SFR", "UFR", "CC", "SASR"):
+    for name in ("scenario", "N", "layouts", "faults", "SSR", "USR", "SFR", "UFR", "CC", "SASR"):
         table.add_column(name, justify="left" if name == "scenario" else "right", no_wrap=True)
     for row in rows:
         m = row.metrics
@@ -244,7 +256,7 @@ def _table(rows: list[Any]):  # -> rich Table
             continue
         cells = [m.ssr, m.usr, m.sfr, m.ufr, m.cc_per_step, m.sasr]
         table.add_row(f"[bold]{row.scenario}[/bold]" if row.scenario == "all" else row.scenario,
-                      str(row.episodes), str(row.faults),
+                      str(row.episodes), str(m.n_layouts), str(row.faults),
                       *(f"{c.estimate:.2f} [{c.low:.2f},{c.high:.2f}]" for c in cells))
     return table
 

@@ -3,8 +3,9 @@
 :func:`play` is the loop the runner and ``fsvla replay --with-policy`` share. It resets
 the environment, tells the policy what it is about to control (:func:`episode_info`,
 the observation/action schema), then asks ``act(observation)`` for an action ``(A,)`` or
-a chunk ``(H, A)`` and executes the chunk itself, one control step per row, asking again
-when the chunk is used up, so the monitor sees every action and every physics substep.
+a chunk ``(H, A)`` and executes the chunk itself, one control step per row (its first
+``replan_steps`` rows, when given, as openpi's clients do), asking again when they are
+used up, so the monitor sees every action and every physics substep.
 
 Anything that goes wrong ends the episode with a :class:`Fault` naming the failure
 reason (``fsvla.results.FailureReason``): the policy raised (``policy_error``), returned
@@ -83,9 +84,11 @@ def episode_info(env: FsvlaEnv, spec: EpisodeSpec) -> EpisodeInfo:
 
 def play(env: FsvlaEnv, policy: Policy, spec: EpisodeSpec, *, timeout: float | None = None,
          on_call: CallHook | None = None,
-         on_frame: Callable[[dict[str, Any]], None] | None = None) -> None:
+         on_frame: Callable[[dict[str, Any]], None] | None = None,
+         replan_steps: int | None = None) -> None:
     """Run one episode of ``policy`` in ``env`` (already varied for ``spec``) to its end;
-    raises :class:`Fault` when it ends in a fault. ``on_frame`` sees every observation.
+    raises :class:`Fault` when it ends in a fault. ``on_frame`` sees every observation;
+    ``replan_steps`` (None: all) is how many rows of each chunk run before asking again.
     A policy with ``bind_env`` (a scripted expert, reading privileged state) is bound to
     ``env`` first."""
     bind = getattr(policy, "bind_env", None)
@@ -99,7 +102,7 @@ def play(env: FsvlaEnv, policy: Policy, spec: EpisodeSpec, *, timeout: float | N
     while True:
         if not chunk:
             answer = _policy_call(policy.act, observation, timeout, "act()", on_call)
-            chunk.extend(as_chunk(answer, env.codec.size))
+            chunk.extend(as_chunk(answer, env.codec.size)[:replan_steps])
         action = chunk.popleft()
         try:
             observation, _, terminated, truncated, _ = env.step(action)

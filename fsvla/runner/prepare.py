@@ -7,7 +7,7 @@ wrong with it (the CLI prints it and exits 2).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -24,6 +24,7 @@ OPTIONS: dict[str, str] = {
     "seeds": "--seeds", "warmup": "--warmup", "control_mode": "--control-mode",
     "obs_mode": "--obs-mode", "embodiment": "--embodiment", "sasr_lambda": "--sasr-lambda",
     "terminate_on_violation": "--terminate-on-violation", "policy_timeout_s": "--policy-timeout",
+    "policy_profile": "--policy-profile", "replan_steps": "--replan-steps",
 }
 
 
@@ -91,6 +92,8 @@ def make_config(**fields: Any) -> RunConfig:
     if config.obs_mode == "state" and config.visions != ("V0",):
         raise RunInputError("--vision", f"{', '.join(v for v in config.visions if v != 'V0')} "
                             "change only the pictures a policy sees; they need --obs-mode rgb")
+    if config.policy_profile is not None:
+        _check_profile(config)
     if config.embodiment is not None:
         from fsvla.embodiments import load_embodiment
 
@@ -99,6 +102,50 @@ def make_config(**fields: Any) -> RunConfig:
         except (KeyError, ValueError, OSError) as err:
             raise RunInputError("--embodiment", str(err.args[0] if err.args else err)) from None
     return config
+
+
+def profile_defaults(fields: dict[str, Any], given: Collection[str]) -> dict[str, Any]:
+    """``fields`` (RunConfig fields) with what their ``policy_profile`` decides unless an
+    option sets it (``given``: the fields set by options): the control mode its actions
+    are in, its replan steps, rgb observations when it sends images. A stored run's value
+    stays, unless the profile is given anew."""
+    spec = fields.get("policy_profile")
+    if not spec:
+        return fields
+    profile = _load_profile(spec)
+    decided = {"control_mode": profile.control_mode, "replan_steps": profile.replan_steps,
+               "obs_mode": "rgb" if profile.sends_images else None}
+    fields = dict(fields)
+    for name, value in decided.items():
+        if value is not None and name not in given and (
+                fields.get(name) is None or "policy_profile" in given):
+            fields[name] = value
+    return fields
+
+
+def _check_profile(config: RunConfig) -> None:
+    """A profile must speak to a policy server, in its own control mode, with the
+    pictures it sends."""
+    profile = _load_profile(config.policy_profile or "")
+    if not config.policy.startswith(("ws://", "wss://")):
+        raise RunInputError("--policy-profile", f"--policy-profile maps the keys of a policy "
+                            f"server (--policy ws://host:port); --policy {config.policy} is none")
+    if profile.control_mode is not None and config.control_mode != profile.control_mode:
+        raise RunInputError("--control-mode", f"profile {profile.name} decodes its server's "
+                            f"actions as {profile.control_mode}, not {config.control_mode}; "
+                            "leave --control-mode out (the profile sets it)")
+    if profile.sends_images and config.obs_mode != "rgb":
+        raise RunInputError("--obs-mode", f"profile {profile.name} sends camera images; it "
+                            "needs --obs-mode rgb (the default with this profile)")
+
+
+def _load_profile(spec: str):  # -> Profile
+    from fsvla.policies.profile import ProfileError, load_profile
+
+    try:
+        return load_profile(spec)
+    except ProfileError as err:
+        raise RunInputError("--policy-profile", str(err)) from None
 
 
 def prepare_run(config: RunConfig) -> PreparedRun:
@@ -139,4 +186,4 @@ def check_run_folder(out: Path, config: RunConfig, *, extend: bool = False) -> b
 
 
 __all__ = ["OPTIONS", "PreparedRun", "RunInputError", "check_run_folder", "make_config",
-           "plan_scenarios", "prepare_run", "scenario_refs"]
+           "plan_scenarios", "prepare_run", "profile_defaults", "scenario_refs"]

@@ -87,7 +87,7 @@ def replay_episode(run_dir: Path, episode_id: str, *, with_policy: bool = False,
     if with_policy:
         try:
             play(env, load_run_policy(config), spec, timeout=config.policy_timeout_s,
-                 on_frame=on_frame)
+                 on_frame=on_frame, replan_steps=config.replan_steps)
         except Fault as fault:
             result.replay_fault = fault.reason
         if result.replay_fault != row.failure_reason:

@@ -34,11 +34,11 @@ if TYPE_CHECKING:
 REMOTE_SLACK_S = 1.0
 
 def load_run_policy(config: RunConfig) -> Policy:
-    """The run's policy (raises ``PolicyLoadError``), with the run's timeout given to a
-    remote policy as its own reply timeout."""
+    """The run's policy (raises ``PolicyLoadError``), speaking the run's profile, with the
+    run's timeout given to a remote policy as its own reply timeout."""
     from fsvla.policies import load_policy
 
-    policy = load_policy(config.policy)
+    policy = load_policy(config.policy, profile=config.policy_profile)
     if config.policy_timeout_s is not None and hasattr(policy, "reply_timeout"):
         policy.reply_timeout = config.policy_timeout_s + REMOTE_SLACK_S  # type: ignore[attr-defined]
     return policy
@@ -89,7 +89,7 @@ class EpisodeWorker:
             env = make_env(spec, self.config, scenario=self._scenario(spec.scenario_ref))
             assert self._policy is not None
             play(env, self._policy, spec, timeout=self.config.policy_timeout_s,
-                 on_call=self.on_call)
+                 on_call=self.on_call, replan_steps=self.config.replan_steps)
         except Fault as raised:
             fault = raised
         except Exception as err:  # noqa: BLE001 - building the env, loading the policy

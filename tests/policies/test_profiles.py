@@ -228,3 +228,35 @@ def test_an_example_server_refuses_fsvla_s_own_keys() -> None:
             policy.act(_observation())
     assert "missing ['observation/exterior_image_1_left'" in handler.errors[0]
 
+
+# ---------------------------------------------------------------- fsvla run's options
+@pytest.mark.parametrize(("args", "says"), [
+    (["--policy-profile", "drod"], ("error: --policy-profile 'drod': not a built-in profile or "
+                                   "a .toml file; did you mean `droid`?")),
+    (["--policy-profile", "droid", "--policy", "random"],
+     ("error: --policy-profile maps the keys of a policy server (--policy ws://host:port); "
+     "--policy random is none")),
+    (["--policy-profile", "droid", "--control-mode", "joint_pos"],
+     ("--control-mode: profile droid decodes its server's actions as joint_vel, not joint_pos; "
+     "leave --control-mode out")),
+    (["--policy-profile", "libero", "--obs-mode", "state"],
+     "--obs-mode: profile libero sends camera images; it needs --obs-mode rgb"),
+    (["--policy-profile", "{bad}"], ("mine.toml: `action.scael` is not a profile setting; "
+                                    "remove it or correct its name (did you mean `scale`?)")),
+])
+def test_fsvla_run_refuses_a_bad_profile_with_exit_2(tmp_path: Path, capsys, args: list[str],
+                                                     says: str) -> None:
+    from fsvla.cli import run
+
+    bad = _profile_file(tmp_path, GOOD + "scael = 2\n")
+    argv = ["run", "--policy", "ws://127.0.0.1:9", "--scenarios", "short_lift", "--workers", "0",
+            "--out", str(tmp_path / "never")]
+    for option, value in zip(args[::2], args[1::2]):
+        if option in argv:  # replace --policy
+            argv[argv.index(option) + 1] = value
+        else:
+            argv += [option, value.replace("{bad}", bad)]
+    assert run(argv) == 2
+    err = capsys.readouterr().err
+    assert says in " ".join(err.split()) and "Traceback" not in err
+    assert not (tmp_path / "never").exists()
