@@ -31,7 +31,10 @@ from numpy.typing import NDArray
 
 from fsvla.compiler.assets.model import Appearance, ArticulatedAsset, RigidAsset, ZoneAsset
 from fsvla.compiler.scene import PhysicsSpec, SceneBody, SceneSpec, SceneZone
+from fsvla.world import WorldPose
 
+from .appearance import SapienAppearance
+from .kinematics import ArmKinematics
 from .render import (
     DEFAULT_SHADER,
     RenderUnavailable,
@@ -56,7 +59,9 @@ FLOOR_COLOR = (0.55, 0.55, 0.52, 1.0)
 
 @dataclass
 class BuiltScene:
-    """A SceneSpec built in SAPIEN; names are the spec's."""
+    """A SceneSpec built in SAPIEN; names are the spec's. It is the SAPIEN back-end's
+    :class:`fsvla.world.SceneState`, and :meth:`appearance` its
+    :class:`fsvla.world.SceneAppearance`."""
 
     spec: SceneSpec
     scene: Any  # sapien.Scene
@@ -128,6 +133,45 @@ class BuiltScene:
             parts += [np.asarray(articulation.get_qpos(), dtype=np.float64),
                       np.asarray(articulation.get_qvel(), dtype=np.float64)]
         return np.concatenate(parts) if parts else np.zeros(0)
+
+    # --- fsvla.world.SceneState: what the experts read ------------------------------------
+    def body_pose(self, body: str) -> WorldPose:
+        pose = (self.bodies[body].pose if body in self.bodies
+                else self.articulations[body].get_root_pose())
+        return WorldPose(pose.p, pose.q)
+
+    def link_pose(self, body: str, link: str) -> WorldPose:
+        found = next(lk for lk in self.articulations[body].get_links() if lk.name == link)
+        pose = found.entity_pose
+        return WorldPose(pose.p, pose.q)
+
+    def joint_position(self, body: str, joint: str) -> float:
+        articulation = self.articulations[body]
+        index = [j.name for j in articulation.get_active_joints()].index(joint)
+        return float(articulation.get_qpos()[index])
+
+    def arm_joints(self, arm: str) -> NDArray[np.float64]:
+        return self.robot.arm(arm).qpos()
+
+    def gripper_opening(self, arm: str) -> float:
+        return self.robot.arm(arm).gripper_opening()
+
+    def tcp_pose(self, arm: str) -> WorldPose:
+        pose = self.robot.arm(arm).tcp_pose()
+        return WorldPose(pose.p, pose.q)
+
+    def robot_link_pose(self, arm: str, link: str) -> WorldPose:
+        found = next(lk for lk in self.robot.arm(arm).articulation.links if lk.name == link)
+        pose = found.entity_pose
+        return WorldPose(pose.p, pose.q)
+
+    def arm_model(self, arm: str) -> ArmKinematics:
+        return ArmKinematics(self.robot.arm(arm))
+
+    # --- fsvla.world.SceneAppearance: what the visual variation changes ---------------------
+    def appearance(self) -> SapienAppearance:
+        """The scene's look (``ValueError`` for a scene built without rendering)."""
+        return SapienAppearance(self)
 
 
 def build(spec: SceneSpec, *, render: bool | None = None, shader: str = DEFAULT_SHADER,

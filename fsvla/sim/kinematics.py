@@ -1,13 +1,13 @@
-"""Forward and inverse kinematics of a loaded arm's tool centre point (TCP).
+"""Forward and inverse kinematics of a loaded arm's tool centre point (TCP) and links.
 
 Uses the Pinocchio model SAPIEN builds from an articulation (``create_pinocchio_model``,
 damped least-squares CLIK). Poses are in the table (world) frame; quaternions wxyz.
+:class:`ArmKinematics` is the SAPIEN back-end's :class:`fsvla.world.ArmModel`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -20,27 +20,12 @@ from fsvla.compiler.pose import (
     point_axis,
     quat_to_matrix,
     rotation_angle,
+    transform_points,
 )
+from fsvla.embodiments.spec import ArmSpec
+from fsvla.world import IKResult
 
 from .robot import LoadedArm
-
-
-@dataclass(frozen=True)
-class IKResult:
-    """An IK answer, checked by forward kinematics."""
-
-    qpos: NDArray[np.float64]  # the arm's joints, in the spec's order
-    converged: bool  # the solver's own verdict
-    position_error: float  # metres, |FK(qpos) TCP - target|
-    rotation_error: float  # radians, angle between FK(qpos) TCP and target orientation
-    within_limits: bool  # every joint inside its URDF limits
-
-    def ok(self, position_tol: float = 0.01, rotation_tol: float = 0.05) -> bool:
-        return (
-            self.within_limits
-            and self.position_error <= position_tol
-            and self.rotation_error <= rotation_tol
-        )
 
 
 class ArmKinematics:
@@ -57,6 +42,35 @@ class ArmKinematics:
         self._tcp = sapien.Pose(list(arm.spec.tcp_offset))
         joints = arm.articulation.active_joints
         self.limits = np.array([joints[i].limit[0] for i in arm.joint_indices], dtype=np.float64)
+
+    @property
+    def spec(self) -> ArmSpec:
+        return self.arm.spec
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Every link of the arm's articulation, in its order (the index of a link)."""
+        return tuple(link.name for link in self.arm.articulation.get_links())
+
+    def link_poses(self, arm_q: Sequence[float],
+                   links: Sequence[int]) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """World positions (n, 3) and quaternions (n, 4) of ``links`` at arm joints ``arm_q``."""
+        self._model.compute_forward_kinematics(self._full(arm_q))
+        root = self.arm.articulation.get_root_pose()
+        poses = [root * self._model.get_link_pose(i) for i in links]
+        return (np.array([pose.p for pose in poses]).reshape(-1, 3),
+                np.array([pose.q for pose in poses]).reshape(-1, 4))
+
+    def link_vertices(self, link: int) -> NDArray[np.float64] | None:
+        """The vertices of a link's convex collision pieces, in the link's frame."""
+        parts = []
+        for shape in self.arm.articulation.get_links()[link].collision_shapes:
+            if not hasattr(shape, "get_vertices"):
+                continue
+            v = np.asarray(shape.get_vertices(), dtype=np.float64) * np.asarray(shape.scale)
+            pose = shape.local_pose
+            parts.append(transform_points(v, pose.p, pose.q))
+        return np.concatenate(parts) if parts else None
 
     def _full(self, arm_q: Sequence[float] | None) -> NDArray[np.float64]:
         full = np.asarray(self.arm.articulation.get_qpos(), dtype=np.float64).copy()
