@@ -217,7 +217,8 @@ class FsvlaEnv(gymnasium.Env):
         """A fresh SAPIEN scene of the layout, with its monitor and visual variation."""
         self.built = build(self.scene_spec, render=self._render)
         self.monitor = SafetyMonitor(self.monitor_spec, self.built) if self.config.monitor else None
-        self._vision = VisionApplier(self.built) if self.built.renders else None
+        self._vision = (VisionApplier(self.built.appearance(), self.scene_spec)
+                        if self.built.renders else None)
         self._stepped = False
 
     def _check_start(self) -> None:

@@ -1,26 +1,39 @@
-"""Apply a :class:`~fsvla.variation.vision.VisionPerturbation` to a built, rendering scene.
+"""Apply a :class:`~fsvla.variation.vision.VisionPerturbation` to a rendering scene's look.
 
-:class:`VisionApplier` remembers how the scene looked when it was made (light colours,
-the key light's pose, materials, head-camera poses) so that each episode starts from
-V0 and applies its own perturbation: ``apply(p)`` restores, then changes the lights,
-repaints or textures materials, moves the world-mounted cameras, and adds visual-only
-occluders. Nothing here touches a physics component, so an episode's state trace is the
-same at every V level. :meth:`VisionApplier.composite` pastes the V4 patches onto the
-images a policy receives.
+:class:`VisionApplier` works through :class:`fsvla.world.SceneAppearance` (``fsvla.sim``
+implements it for SAPIEN: ``BuiltScene.appearance()``). It remembers how the scene looked
+when it was made (ambient and light colours, the lights' poses, materials' base colours,
+world-camera poses) so that each episode starts from V0 and applies its own perturbation:
+``apply(p)`` restores, then changes the lights, repaints or textures materials, moves the
+world-mounted cameras, and adds visual-only occluders. The appearance touches no physics,
+so an episode's state trace is the same at every V level. :meth:`VisionApplier.composite`
+pastes the V4 patches onto the images a policy receives.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.pose import axis_angle_quat, look_along_quat, yaw_quat
-from fsvla.sim.builder import BuiltScene
+from fsvla.compiler.pose import (
+    look_along_quat,
+    transform_points,
+)
+from fsvla.compiler.scene import SceneSpec
+from fsvla.world import (
+    Camera,
+    Color,
+    Light,
+    Material,
+    PoseReading,
+    SceneAppearance,
+    Undo,
+    WorldPose,
+)
 
 from .vision import CameraShift, Patch, VisionPerturbation
 
@@ -29,40 +42,34 @@ TEXTURE_PIXELS = 128
 TEXTURE_PERIOD = 0.4
 #: Where an occluder stands on the ray from the camera to its target (share of the way).
 OCCLUDER_DEPTH = 0.35
+#: An occluder's colour (RGBA) and thickness (m, along the camera's ray).
+OCCLUDER_COLOR = (0.35, 0.33, 0.3, 1.0)
+OCCLUDER_THICKNESS = 0.004
 
 
 @dataclass
 class _Original:
-    ambient: tuple[float, ...]
-    lights: list[tuple[Any, tuple[float, ...], Any]]  # component, colour, entity pose
-    materials: list[tuple[Any, tuple[float, ...], Any]]  # material, base colour, texture
-    cameras: list[tuple[Any, Any]]  # world camera entity, pose
-    uvs: dict[int, NDArray[np.float32]] = field(default_factory=dict)
+    ambient: Color
+    lights: list[tuple[Light, Color, PoseReading]]
+    materials: list[tuple[Material, Color]]
+    cameras: list[tuple[Camera, PoseReading]]  # the world-mounted ones
 
 
 class VisionApplier:
-    """Applies perturbations to one built scene; ``apply`` always starts from V0."""
+    """Applies perturbations to one scene's look; ``apply`` always starts from V0."""
 
-    def __init__(self, built: BuiltScene) -> None:
-        import sapien
-
-        if not built.renders:
-            raise ValueError("visual variation needs a scene built with rendering")
-        self.built = built
-        self._sapien = sapien
-        scene = built.scene
-        lights = [c for e in scene.entities for c in e.components
-                  if isinstance(c, sapien.render.RenderLightComponent)]
+    def __init__(self, appearance: SceneAppearance, spec: SceneSpec) -> None:
+        self.appearance = appearance
+        self.spec = spec
+        cameras = [appearance.camera(c.name) for c in spec.cameras if c.parent == "world"]
         self._original = _Original(
-            ambient=tuple(scene.ambient_light),
-            lights=[(c, tuple(c.color), c.entity.pose) for c in lights],
-            materials=[(m, tuple(m.base_color), m.base_color_texture)
-                       for name in self._named_entities() for m in self._materials(name)],
-            cameras=[(built.cameras[c.name].entity, built.cameras[c.name].entity.pose)
-                     for c in built.spec.cameras if c.parent == "world" and c.name in built.cameras],
+            ambient=appearance.ambient,
+            lights=[(light, light.color, light.pose) for light in appearance.lights()],
+            materials=[(m, m.base_color) for name in appearance.names()
+                       for m in appearance.materials(name)],
+            cameras=[(camera, camera.pose) for camera in cameras],
         )
-        self._occluders: list[Any] = []
-        self._swapped: list[tuple[Any, Any, Any]] = []  # entity, original, textured body
+        self._undo: list[Undo] = []  # textures and occluders, in the order added
         self.current = VisionPerturbation()
 
     # ------------------------------------------------------------------ public
@@ -72,10 +79,11 @@ class VisionApplier:
         if perturbation.lighting is not None:
             self._light(perturbation)
         for recolor in perturbation.recolors:
-            for material in self._materials(recolor.target):
-                material.base_color = [*recolor.color, material.base_color[3]]
+            for material in self.appearance.materials(recolor.target):
+                material.base_color = (*recolor.color, material.base_color[3])
         for texture in perturbation.textures:
-            self._texture(texture.target, texture.pattern)
+            self._undo.append(self.appearance.paint(
+                texture.target, pattern_image(texture.pattern, TEXTURE_PIXELS), TEXTURE_PERIOD))
         if perturbation.camera is not None:
             self._move_cameras(perturbation.camera)
         for occluder in perturbation.occluders:
@@ -83,24 +91,19 @@ class VisionApplier:
         self.current = perturbation
 
     def restore(self) -> None:
-        """Back to how the scene was built (V0)."""
+        """Back to how the scene was made (V0)."""
         original = self._original
-        self.built.scene.ambient_light = list(original.ambient)
-        for component, color, pose in original.lights:
-            component.color = list(color)
-            component.entity.pose = pose
-        for material, color, texture in original.materials:
-            material.base_color = list(color)
-            material.base_color_texture = texture
-        for entity, pose in original.cameras:
-            entity.pose = pose
-        for entity in self._occluders:
-            self.built.scene.remove_entity(entity)
-        self._occluders = []
-        for entity, original, textured in reversed(self._swapped):
-            entity.remove_component(textured)
-            entity.add_component(original)
-        self._swapped = []
+        self.appearance.ambient = original.ambient
+        for light, color, pose in original.lights:
+            light.color = color
+            light.pose = pose
+        for material, color in original.materials:
+            material.base_color = color
+        for camera, pose in original.cameras:
+            camera.pose = pose
+        for undo in reversed(self._undo):
+            undo()
+        self._undo = []
         self.current = VisionPerturbation()
 
     def composite(self, images: dict[str, NDArray[np.uint8]]) -> dict[str, NDArray[np.uint8]]:
@@ -111,159 +114,79 @@ class VisionApplier:
         for name, image in images.items():
             picture = image.copy()
             for patch in self.current.patches:
-                self._paste(picture, self.built.cameras[name], patch)
+                self._paste(picture, self.appearance.camera(name), patch)
             out[name] = picture
         return out
 
     # ------------------------------------------------------------------ pieces
-    def _named_entities(self) -> list[str]:
-        return [*self.built.bodies, *self.built.articulations, *self.built.zones]
-
-    def _entities_of(self, name: str) -> list[Any]:
-        if name in self.built.bodies:
-            return [self.built.bodies[name]]
-        if name in self.built.articulations:
-            return [link.entity for link in self.built.articulations[name].links]
-        zone = self.built.zones.get(name)
-        return [zone] if zone is not None else []
-
-    def _materials(self, name: str) -> list[Any]:
-        sapien = self._sapien
-        found = []
-        for entity in self._entities_of(name):
-            for component in entity.components:
-                if not isinstance(component, sapien.render.RenderBodyComponent):
-                    continue
-                for shape in component.render_shapes:
-                    if isinstance(shape, sapien.render.RenderShapeTriangleMesh):
-                        found += [part.material for part in shape.parts]
-                    else:
-                        found.append(shape.material)
-        return found
-
     def _check_targets(self, perturbation: VisionPerturbation) -> None:
-        names = set(self._named_entities())
+        names = set(self.appearance.names())
         targets = [t.target for t in (*perturbation.recolors, *perturbation.textures,
                                       *perturbation.occluders, *perturbation.patches)]
         unknown = sorted({t for t in targets if t not in names})
         if unknown:
             raise ValueError(f"visual variation names {', '.join(unknown)}, which the scene "
-                             f"{self.built.spec.scenario!r} does not have")
+                             f"{self.spec.scenario!r} does not have")
 
     def _light(self, perturbation: VisionPerturbation) -> None:
         lighting = perturbation.lighting
         assert lighting is not None
         factor = np.asarray(lighting.color) * lighting.intensity
-        self.built.scene.ambient_light = list(np.asarray(self._original.ambient) * factor)
+        self.appearance.ambient = tuple(np.asarray(self._original.ambient) * factor)
         key_done = False
-        for component, color, _ in self._original.lights:
-            component.color = list(np.asarray(color) * factor)
-            if (lighting.direction is not None and not key_done
-                    and isinstance(component, self._sapien.render.RenderDirectionalLightComponent)):
-                component.entity.pose = _facing(self._sapien, lighting.direction)
+        for light, color, _ in self._original.lights:
+            light.color = tuple(np.asarray(color) * factor)
+            if lighting.direction is not None and not key_done and light.directional:
+                light.pose = _facing(lighting.direction)
                 key_done = True
 
-    def _texture(self, target: str, pattern: str) -> None:
-        """Swap the target's render body for a copy whose meshes carry planar UVs and the
-        pattern texture (uploaded meshes cannot take new UVs); ``restore`` swaps back."""
-        sapien = self._sapien
-        pixels = pattern_image(pattern, TEXTURE_PIXELS)
-        texture = sapien.render.RenderTexture2D(pixels, "R8G8B8A8Unorm", srgb=True)
-        for entity in self._entities_of(target):
-            for component in list(entity.components):
-                if not isinstance(component, sapien.render.RenderBodyComponent):
-                    continue
-                textured = sapien.render.RenderBodyComponent()
-                for shape in component.render_shapes:
-                    for copy in _textured_copies(sapien, shape, texture):
-                        textured.attach(copy)
-                textured.name = component.name
-                entity.remove_component(component)
-                entity.add_component(textured)
-                self._swapped.append((entity, component, textured))
-
     def _move_cameras(self, shift: CameraShift) -> None:
-        sapien = self._sapien
-        turn = (sapien.Pose(q=list(yaw_quat(shift.yaw)))
-                * sapien.Pose(q=list(axis_angle_quat((0.0, 1.0, 0.0), shift.pitch))))
-        for entity, pose in self._original.cameras:
-            moved = sapien.Pose(np.asarray(pose.p) + np.asarray(shift.offset), pose.q)
-            entity.pose = moved * turn
+        """Each world camera, at its V0 pose, shifted by the offset and turned by the yaw
+        and the pitch in its own frame."""
+        for camera, _ in self._original.cameras:
+            camera.move(shift.offset, shift.yaw, shift.pitch)
 
     def _occlude(self, target: str, coverage: float) -> None:
-        sapien = self._sapien
         centre, radius = self._extent(target)
-        for entity, _ in self._original.cameras:
-            eye = np.asarray(entity.pose.p)
+        for camera, _ in self._original.cameras:
+            eye = np.asarray(camera.pose.p)
             ray = centre - eye
             distance = float(np.linalg.norm(ray))
             if distance < 1e-6:
                 continue
             at = eye + OCCLUDER_DEPTH * ray
             side = 2.0 * radius * OCCLUDER_DEPTH * math.sqrt(coverage)
-            builder = self.built.scene.create_actor_builder()
-            material = sapien.render.RenderMaterial(base_color=[0.35, 0.33, 0.3, 1.0], roughness=0.9)
-            builder.add_box_visual(half_size=[0.002, side / 2, side / 2], material=material)
-            occluder = builder.build_kinematic(name=f"occluder_{target}")
-            # Kinematic bodies still collide: make it visual-only by dropping its physics.
-            for component in list(occluder.components):
-                if isinstance(component, sapien.physx.PhysxRigidBaseComponent):
-                    occluder.remove_component(component)
-            occluder.pose = _facing(sapien, ray, at)
-            self._occluders.append(occluder)
+            self._undo.append(self.appearance.add_occluder(
+                target, _facing(ray, at), (OCCLUDER_THICKNESS / 2, side / 2, side / 2),
+                OCCLUDER_COLOR))
 
     def _extent(self, target: str) -> tuple[NDArray[np.float64], float]:
-        """World centre and radius of the target's bounds."""
-        spec = self.built.spec
-        body = next((b for b in spec.bodies if b.name == target), None)
+        """World centre and radius of the target's bounds (at its spec pose)."""
+        body = next((b for b in self.spec.bodies if b.name == target), None)
         if body is not None:
             bounds = body.asset.bounds
-            pose = self._sapien.Pose(list(body.pose.position), list(body.pose.quaternion))
-            centre = np.asarray((pose * self._sapien.Pose(list(bounds.center))).p)
+            centre = transform_points([bounds.center], body.pose.position, body.pose.quaternion)[0]
             return centre, float(np.linalg.norm(bounds.half_extents))
-        zone = spec.zone(target)
+        zone = self.spec.zone(target)
         lo, hi = np.asarray(zone.region_bounds.min), np.asarray(zone.region_bounds.max)
         return (lo + hi) / 2.0, float(np.linalg.norm(hi - lo) / 2.0)
 
-    def _paste(self, picture: NDArray[np.uint8], camera: Any, patch: Patch) -> None:
+    def _paste(self, picture: NDArray[np.uint8], camera: Camera, patch: Patch) -> None:
         centre, _ = self._extent(patch.target)
-        extrinsic = np.asarray(camera.get_extrinsic_matrix(), dtype=np.float64)
-        intrinsic = np.asarray(camera.get_intrinsic_matrix(), dtype=np.float64)
+        extrinsic, intrinsic = camera.extrinsic(), camera.intrinsic()
         point = extrinsic @ np.append(centre, 1.0)
         if point[2] <= 1e-6:
             return  # behind the camera
         u, v, _ = intrinsic @ (point / point[2])
-        half = max(1, int(round(patch.size * intrinsic[0, 0] / point[2] / 2.0)))
+        half = max(1, round(patch.size * intrinsic[0, 0] / point[2] / 2.0))
         height, width = picture.shape[:2]
-        x0, x1 = int(round(u)) - half, int(round(u)) + half
-        y0, y1 = int(round(v)) - half, int(round(v)) + half
+        x0, x1 = round(u) - half, round(u) + half
+        y0, y1 = round(v) - half, round(v) + half
         cx0, cx1, cy0, cy1 = max(x0, 0), min(x1, width), max(y0, 0), min(y1, height)
         if cx0 >= cx1 or cy0 >= cy1:
             return
         pixels = patch_pixels(patch.seed, 2 * half)
         picture[cy0:cy1, cx0:cx1] = pixels[cy0 - y0:cy1 - y0, cx0 - x0:cx1 - x0]
-
-
-def _textured_copies(sapien: Any, shape: Any, texture: Any) -> list[Any]:
-    """Render meshes like ``shape``'s parts, with top-down planar UVs and ``texture``."""
-    if not isinstance(shape, sapien.render.RenderShapeTriangleMesh):
-        return [shape.clone()] if hasattr(shape, "clone") else []
-    copies = []
-    for part in shape.parts:
-        vertices = np.asarray(part.vertices, dtype=np.float32)
-        old = part.material
-        material = sapien.render.RenderMaterial(
-            base_color=[1.0, 1.0, 1.0, old.base_color[3]], roughness=old.roughness,
-            metallic=old.metallic, emission=list(old.emission))
-        material.base_color_texture = texture
-        copy = sapien.render.RenderShapeTriangleMesh(
-            vertices=vertices, triangles=np.asarray(part.triangles, dtype=np.uint32),
-            normals=np.asarray(part.get_vertex_normal(), dtype=np.float32),
-            uvs=(vertices[:, :2] / TEXTURE_PERIOD).astype(np.float32), material=material)
-        copy.local_pose = shape.local_pose
-        copy.name = shape.name
-        copies.append(copy)
-    return copies
 
 
 def pattern_image(pattern: str, size: int) -> NDArray[np.uint8]:
@@ -298,13 +221,13 @@ def patch_pixels(seed: int, size: int) -> NDArray[np.uint8]:
     return np.kron(blocks, np.ones((repeat, repeat, 1), dtype=np.uint8))[:size, :size]
 
 
-def _facing(sapien: Any, direction: Sequence[float], at: Sequence[float] = (0.0, 0.0, 0.0)) -> Any:
+def _facing(direction: Sequence[float], at: Sequence[float] = (0.0, 0.0, 0.0)) -> WorldPose:
     """The pose at ``at`` whose +x points along ``direction`` (a directional light's, an
     occluder's), its +z as near up as it can be (+x when ``direction`` is near vertical)."""
     d = np.asarray(direction, dtype=np.float64)
     d = d / (np.linalg.norm(d) or 1.0)
     up = (0.0, 0.0, 1.0) if abs(d[2]) < 0.99 else (1.0, 0.0, 0.0)
-    return sapien.Pose(np.asarray(at, dtype=np.float64), list(look_along_quat(d, up)))
+    return WorldPose(np.asarray(at, dtype=np.float64), np.asarray(look_along_quat(d, up)))
 
 
 __all__ = ["VisionApplier", "patch_pixels", "pattern_image"]

@@ -67,7 +67,7 @@ def test_v4_changes_pictures_but_not_physics(stove, render_device) -> None:
     states, pictures = {}, {}
     for level in ("V0", "V4"):
         built = build(spec, render=True)
-        applier = VisionApplier(built)
+        applier = VisionApplier(built.appearance(), spec)
         applier.apply(perturbation_for(stove, level, 1))
         pictures[level] = applier.composite(built.render_views())
         trace = []
@@ -89,7 +89,7 @@ def test_restore_returns_to_v0(stove, render_device) -> None:
     from fsvla.variation.apply import VisionApplier
 
     built = build(lower_scene(stove), render=True)
-    applier = VisionApplier(built)
+    applier = VisionApplier(built.appearance(), built.spec)
     before = built.render_views()
     applier.apply(perturbation_for(stove, "V4", 3))
     applier.restore()
