@@ -16,11 +16,13 @@ Vertices of the convex collision hulls are a slight over-estimate of the true di
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
 from fsvla.compiler.monitor import RobotEntity, ZoneEntity
-from fsvla.compiler.pose import quat_to_matrix, transform_points
+from fsvla.compiler.pose import quat_to_matrix, rotation_angle
 
 from .world import World
 
@@ -34,9 +36,7 @@ class ArmClearance:
     def __init__(self, world: World, arm: str) -> None:
         self.world = world
         self.kin = world.kinematics(arm)
-        articulation = self.kin.arm.articulation
-        self._root = articulation.get_root_pose()
-        names = [lk.name for lk in articulation.get_links()]
+        names = list(self.kin.link_names)
         links = {e.name: {r.link for r in e.links} for e in world.monitor.entities
                  if isinstance(e, RobotEntity)}
         regions = {e.name for e in world.monitor.entities
@@ -50,7 +50,7 @@ class ArmClearance:
             if channel.metric not in METRICS or channel.reference is None:
                 continue
             watched = set().union(*(links.get(s, set()) for s in channel.subjects))
-            root = self.kin.arm.base_link.name  # the base does not move: no choice to make
+            root = self.kin.spec.base_link  # the base does not move: no choice to make
             indices = sorted(names.index(n) for n in watched
                              if n in names and n != root and names.index(n) not in rigid)
             ref = channel.reference
@@ -62,31 +62,26 @@ class ArmClearance:
         self._zones = zones
         self._vertices: dict[int, NDArray[np.float64]] = {}
         for i in {i for indices, _, _ in self._checks for i in indices}:
-            link = articulation.get_links()[i]
-            parts = []
-            for shape in link.collision_shapes:
-                if not hasattr(shape, "get_vertices"):
-                    continue
-                v = np.asarray(shape.get_vertices(), dtype=np.float64) * np.asarray(shape.scale)
-                pose = shape.local_pose
-                parts.append(transform_points(v, pose.p, pose.q))
-            if parts:
-                self._vertices[i] = np.concatenate(parts)
+            vertices = self.kin.link_vertices(i)
+            if vertices is not None:
+                self._vertices[i] = vertices
 
     def _hand_rigid(self, names: list[str]) -> set[int]:
         """Indices of the links whose pose relative to the TCP no joint of the arm moves."""
-        model, kin = self.kin._model, self.kin
-        home = np.asarray(kin.arm.spec.home, dtype=np.float64)
+        kin = self.kin
+        home = np.asarray(kin.spec.home, dtype=np.float64)
         rng = np.random.default_rng(0)
+        ee, every = names.index(kin.spec.ee_link), range(len(names))
         relative = []
         for q in (home, home + rng.uniform(-0.3, 0.3, home.shape)):
-            model.compute_forward_kinematics(kin._full(q))
-            ee = model.get_link_pose(kin.arm.ee_link_index)
-            relative.append([ee.inv() * model.get_link_pose(i) for i in range(len(names))])
+            p, quat = kin.link_poses(q, every)
+            R = quat_to_matrix(quat)
+            p = np.asarray(p, dtype=np.float64)
+            relative.append([(R[ee].T @ (p[i] - p[ee]), R[ee].T @ R[i]) for i in every])
         rigid = set()
-        for i, (a, b) in enumerate(zip(*relative)):
-            if (np.allclose(a.p, b.p, atol=1e-5)  # float32 poses
-                    and abs(abs(float(np.dot(a.q, b.q))) - 1.0) < 1e-5):
+        for i, ((pa, Ra), (pb, Rb)) in enumerate(zip(*relative)):
+            if (np.allclose(pa, pb, atol=1e-5)  # float32 poses
+                    and 1.0 - math.cos(rotation_angle(Ra, Rb) / 2.0) < 1e-5):
                 rigid.add(i)
         return rigid
 
@@ -99,13 +94,11 @@ class ArmClearance:
         hazard, less the channel's hard limit (negative: a violation)."""
         if not self.active:
             return float("inf")
-        model = self.kin._model
-        model.compute_forward_kinematics(self.kin._full(q))
-        poses = [self._root * model.get_link_pose(i) for i in self._vertices]
-        rotations = quat_to_matrix([pose.q for pose in poses])  # one conversion for all links
+        positions, quaternions = self.kin.link_poses(q, list(self._vertices))
+        rotations = quat_to_matrix(quaternions)  # one conversion for all links
         points: dict[int, NDArray[np.float64]] = {
-            i: v @ R.T + np.asarray(pose.p)
-            for (i, v), R, pose in zip(self._vertices.items(), rotations, poses)
+            i: v @ R.T + p
+            for (i, v), R, p in zip(self._vertices.items(), rotations, positions)
         }
         best = float("inf")
         for indices, ref, limit in self._checks:

@@ -26,8 +26,8 @@ def reachable(world: World, arm: str, grasp: Grasp) -> bool:
     inside its joint limits."""
     from .motion import ArmDriver
 
-    loaded = world.robot.arm(arm)
-    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm), loaded.qpos(), 1.0)
+    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                       world.arm_joints(arm), 1.0)
     for pose in (grasp.pose, grasp.pose.moved(-0.05 * grasp.approach)):
         driver.solve_anywhere(pose)
         if driver.ik_misses:

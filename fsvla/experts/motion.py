@@ -124,7 +124,7 @@ class ArmDriver:
                                   max_iterations=300)
         if not self._comfortable(result):
             best = None
-            for seed in (self.q, self.kin.arm.spec.home, *self._seeds()):
+            for seed in (self.q, self.kin.spec.home, *self._seeds()):
                 r = self.kin.inverse(tuple(pose.p), pose.quat, seed=seed, restarts=0)
                 if self._comfortable(r) and (
                         best is None or _jump(r, self.q) < _jump(best, self.q)):
@@ -196,7 +196,7 @@ class ArmDriver:
             consider(q)
         if best_key is not None and best_key[0] >= self.clear_needed:
             return best
-        for seed in (self.q, self.kin.arm.spec.home, *self._seeds()):
+        for seed in (self.q, self.kin.spec.home, *self._seeds()):
             rb = self.kin.inverse(tuple(branch_of.p), branch_of.quat, seed=seed, restarts=0,
                                   max_iterations=300)
             if not self._comfortable(rb):
@@ -272,7 +272,7 @@ class ArmDriver:
     def _seeds(self) -> list[NDArray[np.float64]]:
         rng = np.random.default_rng(0)
         lo, hi = self.kin.limits[:, 0] + LIMIT_MARGIN, self.kin.limits[:, 1] - LIMIT_MARGIN
-        home = np.asarray(self.kin.arm.spec.home, dtype=np.float64)
+        home = np.asarray(self.kin.spec.home, dtype=np.float64)
         return [np.clip(home + rng.normal(0.0, 0.6, home.shape), lo, hi) for _ in range(16)]
 
     def _wide_seeds(self) -> list[NDArray[np.float64]]:
@@ -410,9 +410,4 @@ def _snapshot(drivers: Mapping[str, ArmDriver], label: str) -> Step:
                 gripper={n: d.gripper for n, d in drivers.items()}, label=label)
 
 
-def current_pose(arm) -> Pose:
-    pose = arm.tcp_pose()
-    return Pose.of(pose.p, quat_to_matrix(pose.q))
-
-
-__all__ = ["ArmDriver", "Pose", "Segment", "Step", "current_pose", "expand"]
+__all__ = ["ArmDriver", "Pose", "Segment", "Step", "expand"]

@@ -66,16 +66,15 @@ class ExpertPolicy:
             raise ExpertNotBound(f"{self.name} needs the environment: call "
                                  "bind_env(env) before reset (see fsvla.experts)")
         # the scene as it is now: an env's reset may have built a new one since bind_env
-        world = self._world = World(self._env)
+        world = self._world = World.of_env(self._env)
         task = world.scenario.task
         if task.name not in TASK_PLANS:
             raise ValueError(f"no expert plan for task {task.name!r}")
         self._drivers = {}
         for name in world.arm_names:
-            arm = world.robot.arm(name)
             self._drivers[name] = ArmDriver(name, world.kinematics(name),
-                                            world.current_pose(name), arm.qpos(),
-                                            arm.gripper_opening())
+                                            world.current_pose(name), world.arm_joints(name),
+                                            world.gripper_opening(name))
             if self.style.avoid_hazards:  # its links too, not only the hand, kept clear
                 clearance = ArmClearance(world, name)
                 self._drivers[name].clearance = clearance if clearance.active else None

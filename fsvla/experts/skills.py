@@ -205,7 +205,7 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
     from .motion import ArmDriver
 
     kin = world.kinematics(arm)
-    now = np.asarray(world.robot.arm(arm).qpos(), dtype=np.float64)
+    now = np.asarray(world.arm_joints(arm), dtype=np.float64)
     probe = ArmDriver(arm, kin, path[0], now, 1.0)
     lo, hi = kin.limits[:, 0] + PATH_MARGIN, kin.limits[:, 1] - PATH_MARGIN
 
@@ -226,7 +226,7 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
         r = kin.inverse(tuple(pose.p), pose.quat, seed=seed, restarts=0, max_iterations=300)
         return np.asarray(r.qpos, dtype=np.float64) if probe._comfortable(r) else None
 
-    seeds = (now, kin.arm.spec.home, *probe._seeds())
+    seeds = (now, kin.spec.home, *probe._seeds())
     best: NDArray[np.float64] | None = None
     for backward in (False, True):
         for seed in seeds:
@@ -287,7 +287,7 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
                   label="touch")
     opening = 1.0 if release_gap is None else min(
-        1.0, world.robot.arm(arm).gripper_opening() + 2 * release_gap / world.max_width(arm))
+        1.0, world.gripper_opening(arm) + 2 * release_gap / world.max_width(arm))
     yield Segment(grippers={arm: opening},
                   gripper_steps=style.gripper_steps * (2 if fragile else 1),
                   settle=style.settle, label="release")

@@ -1,18 +1,26 @@
 """The experts' privileged view of a running scene: object poses, articulated joints,
 hazard geometry and the monitor's limits — what a learned policy does not get.
 
-Built from an :class:`fsvla.env.FsvlaEnv` (its ``built`` scene, ``scene_spec``,
-``monitor_spec`` and ``scenario``); every read is of the current simulator state.
+It reads the simulator through :class:`fsvla.world.SceneState` only (``fsvla.sim``'s
+``BuiltScene`` is one) and plans with its :class:`fsvla.world.ArmModel`; the rest comes
+from the scene spec, the monitor spec and the scenario. Every read is of the current
+state. ``World.of_env(env)`` makes one from an :class:`fsvla.env.FsvlaEnv`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from fsvla.compiler.monitor import MonitorSpec
 from fsvla.compiler.pose import AXES, quat_to_matrix, rotation_angle, rotation_between
+from fsvla.compiler.scene import SceneSpec
+from fsvla.dsl.models import Scenario
+from fsvla.embodiments.spec import ArmSpec
+from fsvla.world import ArmModel, SceneState
 
 from .motion import Pose
 
@@ -28,26 +36,28 @@ class Obstacle:
 
 
 class World:
-    """Privileged state of one environment (see the module doc)."""
+    """Privileged state of one scene (see the module doc)."""
 
-    def __init__(self, env) -> None:
-        self.env = env
-        self.built = env.built
-        self.scene = env.scene_spec
-        self.monitor = env.monitor_spec
-        self.scenario = env.scenario
-        self.robot = env.built.robot
-        self.arm_names = tuple(self.robot.arms)
-        self.dt = float(env.control_dt)
-        self._kinematics: dict[str, object] = {}
+    def __init__(self, state: SceneState, scene: SceneSpec, monitor: MonitorSpec,
+                 scenario: Scenario, dt: float) -> None:
+        self.state = state
+        self.scene = scene
+        self.monitor = monitor
+        self.scenario = scenario
+        self.arms = {arm.name: arm for robot in scene.embodiment.robots for arm in robot.arms}
+        self.arm_names = tuple(self.arms)
+        self.dt = float(dt)
+        self._kinematics: dict[str, ArmModel] = {}
         self._finger_axis: dict[str, NDArray[np.float64]] = {}
+
+    @classmethod
+    def of_env(cls, env: Any) -> World:
+        """The world of an env's current scene (its ``built`` scene and specs)."""
+        return cls(env.built, env.scene_spec, env.monitor_spec, env.scenario, env.control_dt)
 
     # ------------------------------------------------------------------ bodies
     def body_pose(self, name: str) -> Pose:
-        if name in self.built.bodies:
-            pose = self.built.bodies[name].pose
-        else:
-            pose = self.built.articulations[name].get_root_pose()
+        pose = self.state.body_pose(name)
         return Pose.of(pose.p, quat_to_matrix(pose.q))
 
     def asset(self, name: str):
@@ -93,9 +103,8 @@ class World:
 
     # ------------------------------------------------------------------ articulations
     def link_pose(self, body: str, link: str) -> Pose:
-        art = self.built.articulations[body]
-        found = next(lk for lk in art.get_links() if lk.name == link)
-        return Pose.of(found.entity_pose.p, quat_to_matrix(found.entity_pose.q))
+        pose = self.state.link_pose(body, link)
+        return Pose.of(pose.p, quat_to_matrix(pose.q))
 
     def part(self, body: str):
         asset = self.asset(body)
@@ -105,45 +114,58 @@ class World:
 
     def open_fraction(self, body: str) -> float:
         _part, joint = self.part(body)
-        art = self.built.articulations[body]
-        index = [j.name for j in art.get_active_joints()].index(joint.name)
-        q = float(art.get_qpos()[index])
+        q = self.state.joint_position(body, joint.name)
         span = joint.upper - joint.lower
         return abs(q - joint.lower) / abs(span) if span else 0.0
 
     # ------------------------------------------------------------------ arms
-    def kinematics(self, arm: str):
-        if arm not in self._kinematics:
-            from fsvla.sim.kinematics import ArmKinematics
+    def arm_spec(self, arm: str) -> ArmSpec:
+        if arm not in self.arms:
+            raise KeyError(f"embodiment `{self.scene.embodiment.name}` has no arm `{arm}`; "
+                           f"arms: {list(self.arms)}")
+        return self.arms[arm]
 
-            self._kinematics[arm] = ArmKinematics(self.robot.arm(arm))
+    def arm_joints(self, arm: str) -> NDArray[np.float64]:
+        """The arm's joint positions now, in its spec's order."""
+        return self.state.arm_joints(arm)
+
+    def gripper_opening(self, arm: str) -> float:
+        """How open the arm's gripper is now, in [0, 1]."""
+        return self.state.gripper_opening(arm)
+
+    def kinematics(self, arm: str) -> ArmModel:
+        if arm not in self._kinematics:
+            self._kinematics[arm] = self.state.arm_model(arm)
         return self._kinematics[arm]
 
     def base_position(self, arm: str) -> NDArray[np.float64]:
-        return np.asarray(self.robot.arm(arm).base_link.entity_pose.p, dtype=np.float64)
+        base = self.state.robot_link_pose(arm, self.arm_spec(arm).base_link)
+        return np.asarray(base.p, dtype=np.float64)
 
     def finger_axis(self, arm: str) -> NDArray[np.float64]:
         """The direction the fingers close along, in the TCP frame (unit)."""
         if arm not in self._finger_axis:
-            loaded = self.robot.arm(arm)
-            tcp = loaded.tcp_pose()
-            R = quat_to_matrix(tcp.q)
-            a, b = (np.asarray(f.entity_pose.p) for f in loaded.finger_links[:2])
-            axis = R.T @ (b - a) if len(loaded.finger_links) > 1 else np.array([0.0, 1.0, 0.0])
+            fingers = self.arm_spec(arm).gripper.finger_links
+            if len(fingers) > 1:
+                R = quat_to_matrix(self.state.tcp_pose(arm).q)
+                a, b = (np.asarray(self.state.robot_link_pose(arm, f).p) for f in fingers[:2])
+                axis = R.T @ (b - a)
+            else:
+                axis = np.array([0.0, 1.0, 0.0])
             axis -= axis @ self.approach_axis(arm) * self.approach_axis(arm)
             self._finger_axis[arm] = axis / np.linalg.norm(axis)
         return self._finger_axis[arm]
 
     def approach_axis(self, arm: str) -> NDArray[np.float64]:
-        return np.asarray(AXES[self.robot.arm(arm).spec.approach_axis], dtype=np.float64)
+        return np.asarray(AXES[self.arm_spec(arm).approach_axis], dtype=np.float64)
 
     def max_width(self, arm: str) -> float:
         """The gripper's opening (m between the fingers) when fully open."""
-        spec = self.robot.arm(arm).spec.gripper
+        spec = self.arm_spec(arm).gripper
         return float(sum(abs(o - c) for o, c in zip(spec.open, spec.closed)))
 
     def gripper_stiffness(self, arm: str) -> float:
-        return float(self.robot.arm(arm).spec.gripper.drive.stiffness)
+        return float(self.arm_spec(arm).gripper.drive.stiffness)
 
     def grasp_frame(self, arm: str, approach: NDArray[np.float64], closing: NDArray[np.float64],
                     near: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
@@ -162,7 +184,7 @@ class World:
         return min(options, key=lambda R: rotation_angle(R, near))
 
     def current_pose(self, arm: str) -> Pose:
-        pose = self.robot.arm(arm).tcp_pose()
+        pose = self.state.tcp_pose(arm)
         return Pose.of(pose.p, quat_to_matrix(pose.q))
 
     # ------------------------------------------------------------------ hazards

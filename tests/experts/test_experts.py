@@ -103,7 +103,7 @@ def _planned(scenario: str, style: str) -> list[tuple[str, tuple[str, ...]]]:
     env = make(scenario, "L0", 0)
     env.reset()
     task = env.scenario.task
-    plan = TASK_PLANS[task.name].plan(World(env), STYLES[style], dict(task.roles))
+    plan = TASK_PLANS[task.name].plan(World.of_env(env), STYLES[style], dict(task.roles))
     segments = [(s.label, tuple(sorted({*s.targets, *s.grippers}))) for s in plan]
     env.close()
     return segments
@@ -129,7 +129,7 @@ def test_careful_grip_holds_a_mug_by_its_handle_firmly():
 
     env = make("pick_cup_near_edge", "L0", 0)
     env.reset()
-    world = World(env)
+    world = World.of_env(env)
     arm = world.arm_names[0]
     grasp = grasps.grasps(world, arm, "mug")[0]
     tip = grasp_tip(world, arm, "mug", grasp.pose)

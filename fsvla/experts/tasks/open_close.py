@@ -113,9 +113,9 @@ def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
     by ``pull`` (m, world) on one IK branch; the one nearer the hand's present turn first.
     Low and close to a Panda's base, one of them has no comfortable answer at all."""
     R0 = world.grasp_frame(arm, approach, UP)
-    loaded = world.robot.arm(arm)
     for R in (R0, axis_angle_matrix(approach, np.pi) @ R0):
-        driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm), loaded.qpos(), 1.0)
+        driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                           world.arm_joints(arm), 1.0)
         tcp = Pose(start, R)
         if driver.branch_that_tracks(tcp, tcp.moved(pull)) is not None:
             return R
