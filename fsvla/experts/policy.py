@@ -33,6 +33,10 @@ from .world import World
 CHUNK = 10
 
 
+#: The control modes the experts' absolute targets are written in.
+EXPERT_MODES = ("joint_pos", "ee_pose")
+
+
 class ExpertNotBound(RuntimeError):
     """An expert was reset or asked to act without ``bind_env(env)``."""
 
@@ -57,7 +61,15 @@ class ExpertPolicy:
 
     # ------------------------------------------------------------------ the hook
     def bind_env(self, env: Any) -> None:
-        """Give the expert the environment whose privileged state it may read."""
+        """Give the expert the environment whose privileged state it may read.
+
+        The expert writes absolute targets, so the env must take them: ``joint_pos`` or
+        ``ee_pose`` (a delta or velocity mode would read them as nonsense of the right size)."""
+        mode = env.codec.mode.value
+        if mode not in EXPERT_MODES:
+            raise ValueError(f"the scripted experts act in the control modes "
+                             f"{' and '.join(EXPERT_MODES)}, not {mode!r}: run them with "
+                             f"--control-mode joint_pos (the default)")
         self._env = env
 
     # ------------------------------------------------------------------ policy API
@@ -148,5 +160,5 @@ def make_expert(env: Any, style: Style | str = "careful", chunk: int = CHUNK) ->
     return expert
 
 
-__all__ = ["CHUNK", "CarefulExpert", "CarelessExpert", "ExpertNotBound", "ExpertPolicy",
-           "make_expert"]
+__all__ = ["CHUNK", "EXPERT_MODES", "CarefulExpert", "CarelessExpert", "ExpertNotBound",
+           "ExpertPolicy", "make_expert"]

@@ -75,6 +75,14 @@ def test_expert_returns_valid_chunks_in_both_control_modes():
         assert np.isfinite(chunk).all()
 
 
+@pytest.mark.parametrize("mode", ["joint_delta", "joint_vel", "ee_delta"])
+def test_an_expert_refuses_a_mode_it_would_misread(mode):
+    env = make("place_glass_on_shelf", "L0", 0, control_mode=mode)
+    with pytest.raises(ValueError, match=f"not '{mode}': run them with --control-mode joint_pos"):
+        make_expert(env, "careful")
+    env.close()
+
+
 def test_an_expert_bound_once_plans_each_episode_on_its_own_scene():
     """An env's reset after an episode builds a new scene: an expert bound before it must
     read that one, not the old scene where the last episode left the arm."""
