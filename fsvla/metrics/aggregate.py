@@ -1,12 +1,18 @@
 """Benchmark-level metrics over many episodes, each with a 95% confidence interval.
 
+Intervals count what is independent: layouts, not episodes. Episodes that share a layout
+(``EpisodeMeta.layout_digest``: the same episode index in several W/V cells of a level,
+or repeats of one layout) are one unit; an episode without a digest is a unit of its own.
+
 * Rates SSR, USR, SFR, UFR (a partition: they sum to 1): the fraction of episodes in each
-  quadrant, with a Wilson score interval.
-* Means of CC / T (the tables' CC), CC, CC / (T · Σ_k w_k), RET/T and SASR(λ) = 1/N Σ_i 1(S_i ∧ ¬V_i) exp(−λ CC_i / T_i)
-  (paper Eq. sasr): the sample mean with a percentile bootstrap interval (resampling
-  episodes with replacement, ``n_resamples`` times, from a ``numpy.random.Generator``
-  seeded with ``seed``, so every interval is reproducible). All means of one call share
-  the same resamples.
+  quadrant, with a Wilson score interval whose n is the number of distinct layouts (the
+  plain Wilson interval when every episode has its own).
+* Means of CC / T (the tables' CC), CC, CC / (T · Σ_k w_k), RET/T and SASR(λ) =
+  1/N Σ_i 1(S_i ∧ ¬V_i) exp(−λ CC_i / T_i) (paper Eq. sasr): the sample mean with a
+  percentile cluster bootstrap interval (resampling layouts with replacement, each with
+  all its episodes, ``n_resamples`` times, from a ``numpy.random.Generator`` seeded with
+  ``seed``, so every interval is reproducible); with one episode a layout it is the plain
+  percentile bootstrap over episodes. All means of one call share the same resamples.
 
 :func:`breakdown` groups episodes by metadata fields (suite, level, policy, …) or by the
 paper's taxonomy (``category``, ``taxonomy_family``) and aggregates each group.
@@ -41,7 +47,7 @@ class Interval(BaseModel):
     estimate: float
     low: float
     high: float
-    method: Literal["wilson", "percentile_bootstrap"]
+    method: Literal["wilson", "percentile_bootstrap", "cluster_bootstrap"]
 
 
 def _z(confidence: float) -> float:
@@ -56,8 +62,12 @@ def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> Interva
         raise ValueError(f"Expect `n` to be positive, actually: {n}")
     if not 0 <= successes <= n:
         raise ValueError(f"Expect 0 <= `successes` <= n = {n}, actually: {successes}")
+    return _wilson(successes / n, n, confidence)
+
+
+def _wilson(p: float, n: int, confidence: float) -> Interval:
+    """The Wilson score interval of proportion ``p`` observed on ``n`` independent units."""
     z = _z(confidence)
-    p = successes / n
     denom = 1 + z * z / n
     centre = (p + z * z / (2 * n)) / denom
     half = z / denom * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
@@ -65,27 +75,53 @@ def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> Interva
                     high=min(1.0, float(centre + half)), method="wilson")
 
 
+def cluster_labels(labels: Sequence[Hashable | None]) -> npt.NDArray[np.int64]:
+    """Each value's cluster, numbered in order of first appearance; a None label is a
+    cluster of its own."""
+    numbers: dict[Hashable, int] = {}
+    out = np.empty(len(labels), dtype=np.int64)
+    for i, label in enumerate(labels):
+        key = ("unlabelled", i) if label is None else ("label", label)
+        out[i] = numbers.setdefault(key, len(numbers))
+    return out
+
+
 def bootstrap_mean_interval(
-    values: npt.ArrayLike, *, confidence: float = 0.95, n_resamples: int = 2000, seed: int = 0
+    values: npt.ArrayLike, *, confidence: float = 0.95, n_resamples: int = 2000, seed: int = 0,
+    clusters: Sequence[Hashable | None] | None = None,
 ) -> Interval:
-    """Sample mean with a percentile bootstrap interval (deterministic for a given ``seed``)."""
+    """Sample mean with a percentile bootstrap interval (deterministic for a given ``seed``).
+
+    ``clusters`` labels each value's independent unit (see :func:`cluster_labels`): a
+    resample draws units with replacement, each with all its values, and takes the mean
+    of the values drawn (a cluster bootstrap). Without it, or with one value a unit, it is
+    the plain bootstrap over values, resample for resample."""
     x = np.asarray(values, dtype=np.float64)
     if x.ndim != 1 or x.size < 1:
         raise ValueError(f"Expect a non-empty 1D array of values, actually: shape {x.shape}")
     if n_resamples < 1:
         raise ValueError(f"Expect `n_resamples` to be positive, actually: {n_resamples}")
     _z(confidence)  # validates it
+    if clusters is not None and len(clusters) != x.size:
+        raise ValueError(f"Expect one cluster label per value ({x.size}), actually: "
+                         f"{len(clusters)}")
+    unit = cluster_labels(clusters) if clusters is not None else np.arange(x.size)
+    units = int(unit.max()) + 1
+    sums = np.bincount(unit, weights=x, minlength=units)
+    sizes = np.bincount(unit, minlength=units).astype(np.float64)
     rng = np.random.default_rng(seed)
-    n = x.size
-    rows = max(1, _BOOTSTRAP_CHUNK // n)
-    means = np.concatenate([
-        x[rng.integers(0, n, size=(min(rows, n_resamples - start), n))].mean(axis=1)
-        for start in range(0, n_resamples, rows)
-    ])
+    rows = max(1, _BOOTSTRAP_CHUNK // units)
+    means = []
+    for start in range(0, n_resamples, rows):
+        drawn = rng.integers(0, units, size=(min(rows, n_resamples - start), units))
+        if units == x.size:  # one value a unit (numbered in order): the plain bootstrap
+            means.append(x[drawn].mean(axis=1))
+        else:
+            means.append(sums[drawn].sum(axis=1) / sizes[drawn].sum(axis=1))
     alpha = 1 - confidence
-    low, high = np.quantile(means, [alpha / 2, 1 - alpha / 2])
+    low, high = np.quantile(np.concatenate(means), [alpha / 2, 1 - alpha / 2])
     return Interval(estimate=float(x.mean()), low=float(low), high=float(high),
-                    method="percentile_bootstrap")
+                    method="percentile_bootstrap" if units == x.size else "cluster_bootstrap")
 
 
 class Aggregate(BaseModel):
@@ -94,6 +130,7 @@ class Aggregate(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     n: int = Field(ge=1)  # episodes
+    n_layouts: int = Field(ge=1)  # distinct layouts among them: the independent units
     ssr: Interval  # safe success rate
     usr: Interval  # unsafe success rate
     sfr: Interval  # safe failure rate
@@ -125,14 +162,17 @@ def aggregate(
     counts = {q: 0 for q in ("safe_success", "unsafe_success", "safe_failure", "unsafe_failure")}
     for ep in episodes:
         counts[ep.quadrant] += 1
-    rates = {q: wilson_interval(c, n, confidence) for q, c in counts.items()}
+    layouts = [ep.meta.layout_digest for ep in episodes]
+    n_layouts = int(cluster_labels(layouts).max()) + 1
+    rates = {q: _wilson(c / n, n_layouts, confidence) for q, c in counts.items()}
 
     def mean(values: list[float]) -> Interval:
-        return bootstrap_mean_interval(values, confidence=confidence,
-                                       n_resamples=n_resamples, seed=seed)
+        return bootstrap_mean_interval(values, confidence=confidence, n_resamples=n_resamples,
+                                       seed=seed, clusters=layouts)
 
     return Aggregate(
         n=n,
+        n_layouts=n_layouts,
         ssr=rates["safe_success"],
         usr=rates["unsafe_success"],
         sfr=rates["safe_failure"],
@@ -230,5 +270,6 @@ __all__ = [
     "aggregate",
     "bootstrap_mean_interval",
     "breakdown",
+    "cluster_labels",
     "wilson_interval",
 ]

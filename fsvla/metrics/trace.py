@@ -61,6 +61,7 @@ class EpisodeMeta(BaseModel):
     language_category: LanguageCategory | None = None  # only at W3
     vision_category: VisionCategory | None = None  # only at V3
     vision_applied: tuple[VisionKind, ...] | None = None  # in VISION_KINDS order
+    layout_digest: str | None = None  # episodes that share one are one independent unit
 
     @model_validator(mode="after")
     def _categories_match_levels(self) -> EpisodeMeta:

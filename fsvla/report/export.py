@@ -34,8 +34,8 @@ def _interval(prefix: str, interval: Interval | None) -> Record:
 def aggregate_records(report: Report) -> list[Record]:
     out = []
     for r in report.aggregate.rows:
-        record: Record = {"policy": r.label, "run_dir": r.run_dir, "n": r.n, **r.counts,
-                          "faults": r.faults}
+        record: Record = {"policy": r.label, "run_dir": r.run_dir, "n": r.n,
+                          "n_layouts": r.n_layouts, **r.counts, "faults": r.faults}
         for name in ("ssr", "usr", "sfr", "ufr", "cc", "sasr", "cc_weighted", "cc_raw",
                      "ret_fraction"):
             record.update(_interval(name, getattr(r, name)))
@@ -52,7 +52,8 @@ def group_records(table: GroupTable) -> list[Record]:
         for policy in table.policies:
             cell = row.cells.get(policy)
             record: Record = {table.by: row.key, "label": row.label, "section": row.section,
-                              "policy": policy, "n": 0 if cell is None else cell.n}
+                              "policy": policy, "n": 0 if cell is None else cell.n,
+                              "n_layouts": 0 if cell is None else cell.n_layouts}
             for name in ("ssr", "cc", "sasr"):
                 record.update(_interval(name, None if cell is None else getattr(cell, name)))
             out.append(record)
@@ -77,6 +78,7 @@ def episode_records(runs: Sequence[RunData]) -> list[Record]:
             out.append({
                 "policy": run.label, "run_dir": str(run.run_dir), "episode_id": ep.id,
                 **m.meta.key.model_dump(exclude={"index", "warmup"}),
+                "layout_seed": row.layout_seed, "layout_digest": row.layout_digest,
                 "categories": ";".join(categories(m.meta)), "status": row.status,
                 "failure_reason": row.failure_reason, "quadrant": m.quadrant,
                 "success": m.success, "violation": m.violation, "horizon": m.horizon,

@@ -12,6 +12,7 @@ from html import escape
 from typing import Any
 
 from fsvla.report.build import Report
+from fsvla.report.protocol import INTERVALS
 from fsvla.report.views import (
     Cell,
     TextTable,
@@ -170,8 +171,8 @@ def page(report: Report, figures: Mapping[str, tuple[str, bytes]] | None = None,
                    "their numbers are not directly comparable.</p>")
     out += ["<ul>", f"<li>Faults and warm-ups: {escape(p.fault_policy)}</li>",
             f"<li>CC: {escape(p.cc_normalisation)}</li>",
-            (f"<li>Intervals: {p.confidence:.0%}; Wilson for rates, percentile bootstrap "
-             f"({p.n_resamples} resamples, seed {p.bootstrap_seed}) for means.</li>"),
+            (f"<li>Intervals: {p.confidence:.0%}; {escape(INTERVALS)} "
+             f"({p.n_resamples} resamples, seed {p.bootstrap_seed}).</li>"),
             ("<li>Every number is a rate or mean over the episodes listed at the end of this "
              "page (and in <code>data/episodes.csv</code>); click a column header to sort.</li>"),
             "</ul>"]
@@ -195,7 +196,7 @@ def page(report: Report, figures: Mapping[str, tuple[str, bytes]] | None = None,
             f"<p>Episode <code>{escape(d.episode_id)}</code> of {escape(d.label)} "
             f"({escape(d.selection)}): {escape(d.quadrant.replace('_', ' '))}, "
             f"{escape(d.key.scenario)} at {d.key.level}/{d.key.language}/{d.key.vision}, "
-            f"seed {d.key.seed}, "
+            f"run seed {d.key.seed}, "
             f"T = {d.horizon}, RET/T = {d.ret_fraction:.2f}, CC = {d.cc:.3f} "
             f"(CC / T = {d.cc_per_step:.3f}).</p>")
         if d.instruction:

@@ -6,6 +6,7 @@ import re
 from collections.abc import Mapping
 
 from fsvla.report.build import Report
+from fsvla.report.protocol import INTERVALS
 from fsvla.report.views import (
     Cell,
     TextTable,
@@ -72,8 +73,8 @@ def page(report: Report, figures: Mapping[str, tuple[str, str]] | None = None) -
                  "numbers are not directly comparable."), ""]
     out += [f"- Faults and warm-ups: {escape(p.fault_policy)}",
             f"- CC: {escape(p.cc_normalisation)}",
-            (f"- Intervals: {p.confidence:.0%}; Wilson for rates, percentile bootstrap "
-             f"({p.n_resamples} resamples, seed {p.bootstrap_seed}) for means."),
+            (f"- Intervals: {p.confidence:.0%}; {escape(INTERVALS)} "
+             f"({p.n_resamples} resamples, seed {p.bootstrap_seed})."),
             "- Every number is a rate or mean over episodes listed in `data/episodes.csv`.", ""]
     out += ["## Aggregate results", "", table(aggregate_view(report))]
     out += _figure(figures, "landscape")

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from pydantic import BaseModel, ConfigDict
 
 from fsvla.metrics import CC_NORMALISATION
+from fsvla.metrics.aggregate import cluster_labels
 from fsvla.report.data import RunData
 from fsvla.report.tables import Settings
 
@@ -23,9 +24,15 @@ FAULT_POLICY = ("Faulted episodes count as task failures, scored on the steps th
                 "excluded from every number.")
 #: The CC scale in one line, for the protocol table (CC_NORMALISATION says it in full).
 CC_SCALE = "CC / T per episode (SASR's scale), averaged; CC/Σw = CC / (T · Σ_k w_k)"
+#: How the intervals are made, in a line (docs/metrics.md, *What is independent*).
+INTERVALS = ("they count distinct layouts, not episodes: Wilson for rates with n = layouts, "
+             "a percentile bootstrap over layouts for means")
+#: How a run drew its layouts, by results schema version (docs/results.md).
+LAYOUT_PROTOCOLS = {1: "one per run seed (results schema 1)",
+                    2: "one per episode: SHA-256 of (run seed, episode index); L0 jittered"}
 #: Protocol fields compared across runs (their values should agree for a fair comparison).
 COMPARED = ("scenario_names", "levels", "languages", "visions", "episodes_per_cell", "seeds",
-            "warmup", "sasr_lambda", "control_mode", "obs_mode", "terminate_on_violation")
+            "layout_protocol", "warmup", "sasr_lambda", "control_mode", "obs_mode", "terminate_on_violation")
 
 
 class RunProtocol(BaseModel):
@@ -44,7 +51,9 @@ class RunProtocol(BaseModel):
     languages: tuple[str, ...]
     visions: tuple[str, ...]
     episodes_per_cell: int
-    seeds: tuple[int, ...]
+    seeds: tuple[int, ...]  # run seeds
+    layout_protocol: str  # how the layouts were drawn (LAYOUT_PROTOCOLS)
+    layouts_scored: int  # distinct layouts among the scored episodes
     warmup: int  # warm-up episodes per scenario (configured)
     warmups_recorded: int  # excluded from every number
     episodes_scored: int
@@ -84,6 +93,11 @@ def _versions(run: RunData) -> dict[str, str]:
     return {name: " → ".join(values) for name, values in seen.items()}
 
 
+def _layouts(run: RunData) -> int:
+    """Distinct layouts among the run's scored episodes (one without a digest counts alone)."""
+    return int(cluster_labels([m.meta.layout_digest for m in run.metrics]).max()) + 1
+
+
 def run_protocol(run: RunData) -> RunProtocol:
     config = run.info.config
     keys = [e.metrics.meta.key for e in run.episodes]
@@ -94,7 +108,9 @@ def run_protocol(run: RunData) -> RunProtocol:
         suites=tuple(sorted({k.suite for k in keys})),
         embodiments=tuple(sorted({k.embodiment for k in keys})),
         levels=config.levels, languages=config.languages, visions=config.visions,
-        episodes_per_cell=config.episodes, seeds=config.seeds, warmup=config.warmup,
+        episodes_per_cell=config.episodes, seeds=config.seeds,
+        layout_protocol=LAYOUT_PROTOCOLS.get(run.info.schema_version, "unknown"),
+        layouts_scored=_layouts(run), warmup=config.warmup,
         warmups_recorded=run.warmups, episodes_scored=len(run.episodes),
         faults=run.fault_counts(), sasr_lambda=config.sasr_lambda,
         control_mode=config.control_mode, obs_mode=config.obs_mode,
@@ -112,5 +128,14 @@ def protocol(runs: Sequence[RunData], settings: Settings) -> Protocol:
                     n_resamples=settings.n_resamples, bootstrap_seed=settings.seed)
 
 
-__all__ = ["CC_SCALE", "COMPARED", "FAULT_POLICY", "Protocol", "RunProtocol", "protocol",
-           "run_protocol"]
+__all__ = [
+    "CC_SCALE",
+    "COMPARED",
+    "FAULT_POLICY",
+    "INTERVALS",
+    "LAYOUT_PROTOCOLS",
+    "Protocol",
+    "RunProtocol",
+    "protocol",
+    "run_protocol",
+]

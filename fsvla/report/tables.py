@@ -3,7 +3,8 @@
 Every number comes from :func:`fsvla.metrics.aggregate` over the episodes of one policy
 (or one group of them), so each is a rate or a mean over episodes that ``episodes.csv``
 lists: filter that file by policy and the group's column to recount it. Rates carry
-Wilson intervals, means percentile-bootstrap intervals (see ``docs/metrics.md``).
+Wilson intervals, means percentile (cluster) bootstrap intervals, both counting distinct
+layouts, which every table shows next to its episode counts (see ``docs/metrics.md``).
 
 The CC of every table is CC / T averaged over episodes, ``Aggregate.cc_per_step``: the
 scale of SASR's exp(−λ · CC_i / T_i), and of the paper's tables (their rows satisfy SASR ≈
@@ -63,6 +64,7 @@ class AggregateRow(BaseModel):
     label: str
     run_dir: str
     n: int
+    n_layouts: int  # distinct layouts: the independent units of the intervals
     counts: dict[str, int]  # episodes per quadrant
     faults: int  # faulted episodes (counted as failures)
     ssr: Interval
@@ -92,6 +94,7 @@ class GroupCell(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     n: int
+    n_layouts: int
     ssr: Interval
     cc: Interval
     sasr: Interval
@@ -159,7 +162,8 @@ def aggregate_table(runs: Sequence[RunData], settings: Settings | None = None) -
         for m in run.metrics:
             counts[m.quadrant] += 1
         rows.append(AggregateRow(
-            label=run.label, run_dir=str(run.run_dir), n=agg.n, counts=counts,
+            label=run.label, run_dir=str(run.run_dir), n=agg.n, n_layouts=agg.n_layouts,
+            counts=counts,
             faults=sum(run.fault_counts().values()), ssr=agg.ssr, usr=agg.usr, sfr=agg.sfr,
             ufr=agg.ufr, cc=agg.cc_per_step, cc_weighted=agg.cc_normalised, cc_raw=agg.cc,
             ret_fraction=agg.ret_fraction,
@@ -170,7 +174,8 @@ def aggregate_table(runs: Sequence[RunData], settings: Settings | None = None) -
 
 
 def _cell(agg: Aggregate) -> GroupCell:
-    return GroupCell(n=agg.n, ssr=agg.ssr, cc=agg.cc_per_step, sasr=agg.sasr)
+    return GroupCell(n=agg.n, n_layouts=agg.n_layouts, ssr=agg.ssr, cc=agg.cc_per_step,
+                     sasr=agg.sasr)
 
 
 def _suite_label(suite: str) -> str:

@@ -8,7 +8,7 @@ from fsvla.metrics import Aggregate, aggregate, breakdown
 from fsvla.metrics.taxonomy import CATEGORY_BY_ID, SUITE_CATEGORY
 from fsvla.results import ResultStore
 
-_COLUMNS = ("SSR", "USR", "SFR", "UFR", "CC", "SASR")
+_COLUMNS = ("Layouts", "SSR", "USR", "SFR", "UFR", "CC", "SASR")
 
 
 def summary_table(store: ResultStore, *, by: str | None = "suite") -> Table:
@@ -44,7 +44,7 @@ def summary_table(store: ResultStore, *, by: str | None = "suite") -> Table:
 
 
 def _values(agg: Aggregate) -> list[str]:
-    return [str(agg.n), *(f"{getattr(agg, m).estimate:.2f}" for m in
+    return [str(agg.n), str(agg.n_layouts), *(f"{getattr(agg, m).estimate:.2f}" for m in
                           ("ssr", "usr", "sfr", "ufr", "cc_per_step", "sasr"))]
 
 

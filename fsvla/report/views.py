@@ -66,7 +66,8 @@ def aggregate_view(report: Report, ci: bool = True, weighted: bool = True) -> Te
         cells = [metric_cell(getattr(r, m), r.label in best[m], ci) for m in metrics]
         if weighted:
             cells.insert(metrics.index("cc") + 1, metric_cell(r.cc_weighted, False, ci))
-        rows.append((Cell(r.label), Cell(str(r.n), r.n), *cells, Cell(str(r.faults), r.faults)))
+        rows.append((Cell(r.label), Cell(str(r.n), r.n), Cell(str(r.n_layouts), r.n_layouts),
+                     *cells, Cell(str(r.faults), r.faults)))
     headings = [_heading(m) for m in metrics]
     if weighted:
         headings.insert(metrics.index("cc") + 1, "CC/Σw")
@@ -75,16 +76,19 @@ def aggregate_view(report: Report, ci: bool = True, weighted: bool = True) -> Te
                f"{report.protocol.confidence:.0%} intervals; CC: cumulative safety cost per "
                "control step (CC / T), averaged over episodes"
                + ("; CC/Σw: the same divided by the channels' total weight" if weighted else "")
-               + f"; SASR at λ = {lam}; means with percentile-bootstrap intervals. Best value "
-               "of each column in bold. N: scored episodes; faults count as failures.")
-    return TextTable("aggregate", caption, ("Policy", "N", *headings, "Faults"), tuple(rows))
+               + f"; SASR at λ = {lam}; means with percentile-bootstrap intervals; every "
+               "interval counts layouts, not episodes (episodes on one layout are one unit). "
+               "Best value of each column in bold. N: scored episodes; Layouts: the distinct "
+               "layouts among them; faults count as failures.")
+    return TextTable("aggregate", caption, ("Policy", "N", "Layouts", *headings, "Faults"),
+                     tuple(rows))
 
 
 def group_view(table: GroupTable, ci: bool = False) -> TextTable:
     name = table.title.removeprefix("Per ")
     header = [name[:1].upper() + name[1:]]
     for _ in table.policies:
-        header += [*(_heading(m) for m in GROUP_METRICS), "n"]
+        header += [*(_heading(m) for m in GROUP_METRICS), "n (layouts)"]
     rows, sections = [], {}
     previous = None
     for i, row in enumerate(table.rows):
@@ -95,14 +99,15 @@ def group_view(table: GroupTable, ci: bool = False) -> TextTable:
         for policy in table.policies:
             cell = row.cells.get(policy)
             if cell is None:
-                cells += [Cell(DASH), Cell(DASH), Cell(DASH), Cell("0", 0)]
+                cells += [Cell(DASH), Cell(DASH), Cell(DASH), Cell("0 (0)", 0)]
                 continue
             cells += [metric_cell(getattr(cell, m), policy in row.best[m], ci)
                       for m in GROUP_METRICS]
-            cells.append(Cell(str(cell.n), cell.n))
+            cells.append(Cell(f"{cell.n} ({cell.n_layouts})", cell.n))
         rows.append(tuple(cells))
     caption = (f"{table.title}: SSR, CC (per step, CC / T) and SASR of each policy; n episodes "
-               "per cell; best of each row in bold.")
+               "per cell (and the distinct layouts among them, which the intervals count); "
+               "best of each row in bold.")
     if table.by == "category":
         caption += (" An episode counts toward its Safe-Core category and toward the Safe-Lang"
                     " (W3–W4) and Safe-Vis (V1–V4) categories of its levels, so n may sum to"
@@ -173,7 +178,9 @@ def protocol_view(protocol: Protocol) -> TextTable:
         ("Language levels (W)", lambda p: _join(p.languages)),
         ("Vision levels (V)", lambda p: _join(p.visions)),
         ("Episodes per cell", lambda p: str(p.episodes_per_cell)),
-        ("Layout seeds", lambda p: _join(p.seeds)),
+        ("Run seeds", lambda p: _join(p.seeds)),
+        ("Layouts", lambda p: p.layout_protocol),
+        ("Distinct layouts scored", lambda p: str(p.layouts_scored)),
         ("Warm-up per scenario (excluded)",
          lambda p: f"{p.warmup} ({p.warmups_recorded} recorded)"),
         ("Scored episodes", lambda p: str(p.episodes_scored)),

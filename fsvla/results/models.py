@@ -26,9 +26,13 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-def layout_digest(scene_json: str) -> str:
-    """The layout digest of an episode: sha256 of its SceneSpec's JSON (``model_dump_json()``)."""
-    return hashlib.sha256(scene_json.encode("utf-8")).hexdigest()
+def layout_digest(scene: Any) -> str:
+    """The layout digest of an episode: sha256 of its SceneSpec's JSON without the seed
+    (``model_dump_json(exclude={"seed"})``), so that two seeds that draw the same layout
+    (``L0: none``, a level without rules) share it, and episodes are counted by layout; a
+    ``str`` is taken as that JSON."""
+    text = scene if isinstance(scene, str) else scene.model_dump_json(exclude={"seed"})
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 class EpisodeOutcome(_Model):
@@ -77,6 +81,7 @@ class EpisodeRow(_Model):
     policy: str
     scenario_ref: str
     scenario_digest: str
+    layout_seed: int
     language_seed: int
     vision_seed: int
     policy_seed: int

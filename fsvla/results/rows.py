@@ -66,7 +66,7 @@ def episode_meta(spec: EpisodeSpec, outcome: EpisodeOutcome, policy: str) -> Epi
     applied = outcome.perturbation.applied() if outcome.perturbation is not None else None
     return EpisodeMeta(key=key, policy=policy, language_category=category,  # type: ignore[arg-type]
                        vision_category=vision_category(key.vision, applied),
-                       vision_applied=applied)
+                       vision_applied=applied, layout_digest=outcome.layout_digest)
 
 
 def vision_category(level: str, applied: tuple[str, ...] | None) -> str | None:
@@ -80,7 +80,8 @@ def vision_category(level: str, applied: tuple[str, ...] | None) -> str | None:
 
 def _row_meta(row: EpisodeRow) -> EpisodeMeta:
     return EpisodeMeta(key=row.key, policy=row.policy, language_category=row.language_category,
-                       vision_category=row.vision_category, vision_applied=row.vision_applied)
+                       vision_category=row.vision_category, vision_applied=row.vision_applied,
+                       layout_digest=row.layout_digest)
 
 
 def score(spec: EpisodeSpec, outcome: EpisodeOutcome, policy: str) -> EpisodeMetrics | None:
@@ -120,7 +121,8 @@ def build_row(spec: EpisodeSpec, outcome: EpisodeOutcome, *, policy: str, lam: f
                         channels=metrics.channels, families=metrics.families)
     return EpisodeRow(
         key=meta.key, session_id=session_id, policy=policy, scenario_ref=spec.scenario_ref,
-        scenario_digest=spec.scenario_digest, language_seed=spec.language_seed,
+        scenario_digest=spec.scenario_digest, layout_seed=spec.layout_seed,
+        language_seed=spec.language_seed,
         vision_seed=spec.vision_seed, policy_seed=spec.policy_seed,
         instruction=instruction.text if instruction else None,
         instruction_origin=instruction.origin if instruction else None,
@@ -198,8 +200,11 @@ def row_from_sql(values: sqlite3.Row) -> EpisodeRow:
 
 def _upgrade(data: dict[str, Any], missing: set[str]) -> None:
     """Fill the columns a schema-1 row lacks (``schema.ADDED_COLUMNS``) from what it has:
-    the kinds of perturbation from the stored perturbation, and with them the V3 category
-    (schema 1 never filled it)."""
+    its layout seed was its run seed (one layout per seed), and the kinds of perturbation
+    come from the stored perturbation, and with them the V3 category (schema 1 never
+    filled it)."""
+    if "layout_seed" in missing:
+        data["layout_seed"] = data["seed"]
     if "vision_applied_json" in missing:
         perturbation = data["perturbation"]
         applied = (VisionPerturbation.model_validate(perturbation).applied()

@@ -14,7 +14,7 @@ SCHEMA_VERSION = 2
 #: Schema versions a reader opens (older ones read-only).
 READABLE_VERSIONS: tuple[int, ...] = (1, 2)
 #: Columns of ``episodes`` each version added, by version.
-ADDED_COLUMNS: dict[int, tuple[str, ...]] = {2: ("vision_applied_json",)}
+ADDED_COLUMNS: dict[int, tuple[str, ...]] = {2: ("layout_seed", "vision_applied_json")}
 DATABASE = "results.sqlite"
 TRACES = "traces"
 LOCK = "lock"
@@ -52,6 +52,7 @@ TABLES: tuple[str, ...] = (
         vision TEXT NOT NULL,
         seed INTEGER NOT NULL,
         episode_index INTEGER NOT NULL,
+        layout_seed INTEGER NOT NULL,       -- with level, the layout (fsvla.run.plan)
         language_seed INTEGER NOT NULL,
         vision_seed INTEGER NOT NULL,
         policy_seed INTEGER NOT NULL,
@@ -94,7 +95,8 @@ TABLES: tuple[str, ...] = (
 
 EPISODE_COLUMNS: tuple[str, ...] = (
     "episode_id", "session_id", "policy", "scenario", "scenario_ref", "scenario_digest", "suite",
-    "embodiment", "level", "language", "vision", "seed", "episode_index", "language_seed",
+    "embodiment", "level", "language", "vision", "seed", "episode_index", "layout_seed",
+    "language_seed",
     "vision_seed", "policy_seed", "warmup", "instruction", "instruction_origin",
     "instruction_category", "language_category", "vision_category", "vision_json",
     "vision_applied_json", "layout_digest", "status", "failure_reason", "failure_detail", "steps", "success",

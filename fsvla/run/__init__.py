@@ -7,7 +7,7 @@ and the report all import :class:`EpisodeKey` from here.
 
 from fsvla.run.config import GRID_FIELDS, ConfigDifference, RunConfig, config_differences
 from fsvla.run.key import EpisodeKey
-from fsvla.run.plan import EpisodeSpec, PlannedScenario, plan_episodes
+from fsvla.run.plan import EpisodeSpec, PlannedScenario, layout_seed, plan_episodes
 from fsvla.run.ranges import (
     RangeError,
     parse_languages,
@@ -25,6 +25,7 @@ __all__ = [
     "RangeError",
     "RunConfig",
     "config_differences",
+    "layout_seed",
     "parse_languages",
     "parse_levels",
     "parse_seeds",

@@ -1,8 +1,9 @@
 """Which episode: :class:`EpisodeKey`, and the names of the benchmark grid it lives in.
 
 An episode of a run is identified by its scenario (with the scenario's suite and the
-embodiment that runs it), its levels L × W × V, its layout seed, and its index within
-its cell (or among the scenario's warm-ups). The plan makes the keys
+embodiment that runs it), its levels L × W × V, the run seed it is drawn from, and its
+index within its cell (or among the scenario's warm-ups); its layout seed is a function
+of the last two (:func:`fsvla.run.plan.layout_seed`). The plan makes the keys
 (:mod:`fsvla.run.plan`); the results store keeps them, one column per field
 (:mod:`fsvla.results.rows` maps them); a policy is told its episode's key
 (:class:`fsvla.policies.base.EpisodeInfo`); the metrics group episodes by them
@@ -30,7 +31,7 @@ SCENARIO_NAME = r"^[A-Za-z0-9_.]+$"
 
 
 class EpisodeKey(BaseModel):
-    """Where one episode sits: scenario × embodiment × L × W × V × layout seed × index.
+    """Where one episode sits: scenario × embodiment × L × W × V × run seed × index.
 
     ``episode_id`` is ``<scenario>-<L>-<W>-<V>-s<seed>-e<index:03d>``, and
     ``<scenario>-warmup-s<seed>-e<index:03d>`` for a warm-up (always at L0/W0/V0):
@@ -48,7 +49,7 @@ class EpisodeKey(BaseModel):
     level: Level = "L0"
     language: Language = "W0"
     vision: Vision = "V0"
-    seed: int = Field(ge=0)  # the layout seed
+    seed: int = Field(ge=0)  # the run seed (one of --seeds) the episode is drawn from
     index: int = Field(default=0, ge=0)  # within its cell, or among the scenario's warm-ups
     warmup: bool = False  # an unscored warm-up episode
 

@@ -6,12 +6,18 @@ every cell (scenario × L × W × V), so a run stopped early still covers every 
 
 How "episodes spread over seeds" is realised, for episode index ``e`` of a cell:
 
-* ``seed`` = ``seeds[e mod len(seeds)]``: the layout seed (with the level it fixes the
-  layout; :class:`~fsvla.run.key.EpisodeKey` ``seed``), round-robin over the seeds;
+* ``seed`` = ``seeds[e mod len(seeds)]``: the run seed the episode is drawn from
+  (:class:`~fsvla.run.key.EpisodeKey` ``seed``, in its id), round-robin over the seeds;
+* ``layout_seed`` = :func:`layout_seed` (``seed``, ``e``): a SHA-256 of both, so every
+  scored episode of a cell has its own layout (with the level, it fixes the layout: at
+  L0 the canonical one with its nuisance jitter), the same on every machine;
 * ``language_seed`` = ``vision_seed`` = ``policy_seed`` = ``e``: they pick the W and V draws
   (``instruction_for`` / ``perturbation_for`` already mix the scenario, dimension and level
-  into their generator) and seed the policy. They do not depend on L, W or V, so episode
-  ``e`` of two cells differs only in the cell's levels (common random numbers).
+  into their generator) and seed the policy.
+
+None of the four depends on W or V (nor the three last on L), so episode ``e`` of two
+cells of a level differs only in the cell's levels (common random numbers): they share
+a layout, which is why intervals count layouts, not episodes (:mod:`fsvla.metrics.aggregate`).
 
 Each episode's :class:`~fsvla.run.key.EpisodeKey` (scenario, suite, embodiment, levels,
 layout seed, index, warm-up flag) gives its id, e.g. ``lift_pot-L1-W3-V0-s2-e007``.
@@ -57,6 +63,7 @@ class EpisodeSpec(BaseModel):
     key: EpisodeKey
     scenario_ref: str
     scenario_digest: str
+    layout_seed: int = Field(ge=0)  # with key.level, the layout (layout_seed())
     language_seed: int = Field(ge=0)
     vision_seed: int = Field(ge=0)
     policy_seed: int = Field(ge=0)
@@ -86,14 +93,28 @@ def plan_episodes(config: RunConfig, scenarios: list[PlannedScenario]) -> list[E
     return specs
 
 
+#: Layout seeds lie in [0, LAYOUT_SEEDS): 31 bits, an INTEGER in every store and language.
+LAYOUT_SEEDS = 2**31
+
+
+def layout_seed(seed: int, index: int, *, warmup: bool = False) -> int:
+    """The layout seed of episode ``index`` drawn from run seed ``seed`` (a warm-up's is
+    drawn apart): SHA-256 of them (``fsvla.compiler.seeding.stable_seed``), 31 bits."""
+    from fsvla.compiler.seeding import stable_seed
+
+    parts = ("layout", seed, index, "warmup") if warmup else ("layout", seed, index)
+    return stable_seed(*parts) % LAYOUT_SEEDS
+
+
 def _spec(config: RunConfig, scenario: PlannedScenario, level: Level, language: Language,
           vision: Vision, index: int, warmup: bool = False) -> EpisodeSpec:
+    seed = config.seeds[index % len(config.seeds)]
     key = EpisodeKey(scenario=scenario.name, suite=scenario.suite,
                      embodiment=config.embodiment or scenario.embodiment, level=level,
-                     language=language, vision=vision,
-                     seed=config.seeds[index % len(config.seeds)], index=index, warmup=warmup)
+                     language=language, vision=vision, seed=seed, index=index, warmup=warmup)
     return EpisodeSpec(key=key, scenario_ref=scenario.ref, scenario_digest=scenario.digest,
+                       layout_seed=layout_seed(seed, index, warmup=warmup),
                        language_seed=index, vision_seed=index, policy_seed=index)
 
 
-__all__ = ["EpisodeSpec", "PlannedScenario", "plan_episodes"]
+__all__ = ["LAYOUT_SEEDS", "EpisodeSpec", "PlannedScenario", "layout_seed", "plan_episodes"]

@@ -155,7 +155,7 @@ def _environment(spec: Any, config: Any, render: bool) -> tuple[Any, str | None]
 
 def _setup_differences(env: Any, row: Any) -> list[str]:
     found = []
-    digest = layout_digest(env.scene_spec.model_dump_json())
+    digest = layout_digest(env.scene_spec)
     if row.layout_digest is not None and digest != row.layout_digest:
         found.append(f"the layout differs (digest {digest[:12]}, recorded "
                      f"{row.layout_digest[:12]}): the scenario file or the compiler changed")

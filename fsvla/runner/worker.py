@@ -51,7 +51,8 @@ def make_env(spec: EpisodeSpec, config: RunConfig, *, render: bool = False,
     from fsvla.env import make
 
     key = spec.key
-    return make(scenario or spec.scenario_ref, key.level, key.seed, embodiment=config.embodiment,
+    return make(scenario or spec.scenario_ref, key.level, spec.layout_seed,
+                embodiment=config.embodiment,
                 obs_mode=config.obs_mode, control_mode=config.control_mode,
                 language=key.language, vision=key.vision, language_seed=spec.language_seed,
                 vision_seed=spec.vision_seed, terminate_on_violation=config.terminate_on_violation,
@@ -111,7 +112,7 @@ class EpisodeWorker:
             failure_detail=fault.detail if fault else None,
             instruction=env.language if env is not None else None,
             perturbation=env.vision if env is not None else None,
-            layout_digest=layout_digest(env.scene_spec.model_dump_json()) if env else None,
+            layout_digest=layout_digest(env.scene_spec) if env else None,
             embodiment=env.config.embodiment if env is not None else None,
             record=record, started_at=started, finished_at=datetime.now(timezone.utc),
             wall_time_s=time.perf_counter() - clock)

@@ -172,3 +172,49 @@ def test_breakdown_field_names_are_checked():
         breakdown(four_quadrants(), by="suit")
     with pytest.raises(ValueError, match="at least one field"):
         breakdown(four_quadrants(), by=())
+
+
+# ---- intervals count layouts, not episodes -------------------------------------------------
+
+def _on_layout(ep, digest):
+    return ep.model_copy(update={"meta": ep.meta.model_copy(update={"layout_digest": digest})})
+
+
+def test_with_a_layout_each_the_cluster_bootstrap_is_the_plain_one():
+    episodes = [_on_layout(ep, f"layout{i}") for i, ep in enumerate(four_quadrants())]
+    agg, plain = aggregate(episodes), aggregate(four_quadrants())
+    assert agg.n_layouts == plain.n_layouts == 4
+    assert agg.model_dump() == plain.model_dump()
+    assert agg.cc.method == "percentile_bootstrap"
+
+
+def test_repeated_layouts_are_one_unit_each():
+    # 3 layouts, each repeated 17 times (a deterministic policy repeats itself): as much
+    # information as 3 episodes, not 51.
+    base = four_quadrants()[:3]  # a safe success, an unsafe failure, a safe failure
+    repeated = [_on_layout(ep, f"layout{i}") for _ in range(17) for i, ep in enumerate(base)]
+    agg = aggregate(repeated, n_resamples=500)
+    assert (agg.n, agg.n_layouts) == (51, 3)
+    assert agg.ssr == wilson_interval(1, 3)
+    assert agg.ssr.high - agg.ssr.low > 2 * (wilson_interval(17, 51).high
+                                             - wilson_interval(17, 51).low)
+    three = bootstrap_mean_interval([ep.cc_per_step for ep in base], n_resamples=500)
+    assert agg.cc_per_step.method == "cluster_bootstrap"
+    assert (agg.cc_per_step.low, agg.cc_per_step.high) == pytest.approx((three.low, three.high))
+    assert agg.cc_per_step.estimate == pytest.approx(three.estimate)
+
+
+def test_episodes_without_a_digest_are_units_of_their_own():
+    episodes = four_quadrants()
+    episodes[1] = _on_layout(episodes[1], "shared")
+    episodes[2] = _on_layout(episodes[2], "shared")
+    agg = aggregate(episodes)
+    assert agg.n_layouts == 3
+    assert agg.cc.method == "cluster_bootstrap"
+
+
+def test_cluster_bootstrap_checks_its_labels():
+    with pytest.raises(ValueError, match="one cluster label per value"):
+        bootstrap_mean_interval([1.0, 2.0], clusters=["a"])
+    ci = bootstrap_mean_interval([1.0, 1.0, 5.0], clusters=["a", "a", "b"], n_resamples=200)
+    assert ci.estimate == pytest.approx(7 / 3) and 1.0 <= ci.low <= ci.high <= 5.0

@@ -19,6 +19,7 @@ must not count). Policy ``a_b & c%`` (awkward for LaTeX and Markdown) and ``beta
 
 from __future__ import annotations
 
+import hashlib
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 from typing import Any
@@ -81,6 +82,13 @@ def perturbation(level: str) -> VisionPerturbation:
     return VisionPerturbation(level=level, patches=(Patch(target="pot", size=0.05, seed=1),))
 
 
+def layout(spec: Any) -> str:
+    """The layout digest a real run would record: one per scenario, level and layout seed,
+    so the W × V cells of an episode index share it (here: one layout per scenario)."""
+    text = f"{spec.key.scenario}/{spec.key.level}/{spec.layout_seed}"
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def outcome(spec: Any, kind: str, success: bool, fault: str | None) -> EpisodeOutcome:
     instruction = (Instruction(level="W3", category="unsafe", text="Touch the stove.",
                                origin="template:lift") if spec.key.language == "W3" else
@@ -89,7 +97,7 @@ def outcome(spec: Any, kind: str, success: bool, fault: str | None) -> EpisodeOu
     return EpisodeOutcome(
         failure_reason="sim_error" if fault else None,
         failure_detail="sim_error: boom" if fault else None, instruction=instruction,
-        perturbation=perturbation(spec.key.vision), layout_digest="ab" * 32,
+        perturbation=perturbation(spec.key.vision), layout_digest=layout(spec),
         record=None if fault == "empty" else record(kind, success), started_at=START,
         finished_at=START + timedelta(seconds=1), wall_time_s=1.0)
 

@@ -66,8 +66,8 @@ def test_summary_table(run_dirs) -> None:
     assert "a_b & c%: 8 scored episode(s)" in text
     assert "Thermal/Energy" in text and "Spatial Boundary" in text
     row = next(line for line in text.splitlines() if line.strip("│ ").startswith("all"))
-    assert [t for t in row.split() if t != "│"] == ["all", "8", "0.38", "0.12", "0.38", "0.12",
-                                                   "0.31", "0.35"]
+    assert [t for t in row.split() if t != "│"] == ["all", "8", "2", "0.38", "0.12", "0.38",
+                                                   "0.12", "0.31", "0.35"]
     assert "2 faulted episode(s) counted as failures" in " ".join(text.split())
 
 

@@ -81,7 +81,7 @@ def test_written_latex_tables(written: Path) -> None:
     aggregate = (written / "tables" / "aggregate.tex").read_text()
     assert r"a\_b \& c\%" in aggregate
     rows = [line for line in aggregate.splitlines() if line.endswith(r"\\")]
-    assert all(len(unescaped(row, "&")) == 9 for row in rows)  # 10 columns
+    assert all(len(unescaped(row, "&")) == 10 for row in rows)  # 11 columns
     assert r"\textbf{0.88}" in aggregate  # beta's SSR is the best
 
 

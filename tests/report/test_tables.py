@@ -35,10 +35,12 @@ def test_aggregate_table(report_data) -> None:
                         "unsafe_failure": 1}
     assert (a.ssr.estimate, a.usr.estimate, a.sfr.estimate, a.ufr.estimate) == (
         0.375, 0.125, 0.375, 0.125)
-    assert a.cc.estimate == approx(2.5 / 8)  # normalised: 0 + .25 + 1 + 1 + 0 + 0 + 0 + .25
+    assert a.cc.estimate == approx(2.5 / 8)  # CC / T: 0 + .25 + 1 + 1 + 0 + 0 + 0 + .25
     assert a.cc_raw.estimate == approx(5.0 / 8)
     assert a.sasr.estimate == approx((2 + E) / 8)
-    assert a.ssr.method == "wilson" and a.cc.method == "percentile_bootstrap"
+    # each scenario's four W × V cells share episode 0's layout: two independent units
+    assert a.n_layouts == 2
+    assert a.ssr.method == "wilson" and a.cc.method == "cluster_bootstrap"
     assert a.ssr.low < 0.375 < a.ssr.high
     assert (b.ssr.estimate, b.usr.estimate, b.sfr.estimate, b.ufr.estimate) == (
         0.875, 0.125, 0.0, 0.0)
