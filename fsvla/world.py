@@ -1,12 +1,14 @@
 """The simulator seam: what fsvla reads from a running scene and what it changes in its look.
 
-The experts (``fsvla.experts``) read a scene through :class:`SceneState` and plan with an
-:class:`ArmModel`; the visual variation (``fsvla.variation.apply``) changes pictures through
-:class:`SceneAppearance`. Both depend on these protocols only, never on a simulator, so a
-second back-end plugs in by implementing them. ``fsvla.sim`` implements them for SAPIEN:
-:class:`fsvla.sim.BuiltScene` is a :class:`SceneState` (its :meth:`arm_model` an
-:class:`fsvla.sim.kinematics.ArmKinematics`), and ``BuiltScene.appearance()`` returns an
-:class:`fsvla.sim.appearance.SapienAppearance`.
+The safety monitor (``fsvla.monitor``) reads a scene through :class:`MonitoredScene` and
+the :class:`StepProbe` it makes; the experts (``fsvla.experts``) read it through
+:class:`SceneState` and plan with an :class:`ArmModel`; the visual variation
+(``fsvla.variation.apply``) changes pictures through :class:`SceneAppearance`. They depend
+on these protocols only, never on a simulator, so a second back-end plugs in by
+implementing them. ``fsvla.sim`` implements them for SAPIEN: :class:`fsvla.sim.BuiltScene`
+is a :class:`MonitoredScene` (its probe a :class:`fsvla.sim.probe.Probe`) and a
+:class:`SceneState` (its :meth:`arm_model` an :class:`fsvla.sim.kinematics.ArmKinematics`),
+and ``BuiltScene.appearance()`` returns an :class:`fsvla.sim.appearance.SapienAppearance`.
 
 The protocols live here, beside ``fsvla.sim`` rather than in it, because ``fsvla.sim`` is
 the SAPIEN back-end: a consumer that imported them from there would name the back-end it
@@ -21,7 +23,7 @@ the simulator's own numbers; :class:`WorldPose` is the plain one to build.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple, Protocol
 
@@ -29,7 +31,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
+    from fsvla.compiler.assets.model import Shape
+    from fsvla.compiler.scene import SceneSpec
     from fsvla.embodiments.spec import ArmSpec
+    from fsvla.monitor.contacts import ContactFilter
+    from fsvla.monitor.state import WorldState as MonitorState
 
 Color = tuple[float, ...]  # RGB or RGBA, linear, in [0, 1]
 Undo = Callable[[], None]  # takes back the change that returned it
@@ -146,6 +152,58 @@ class SceneState(Protocol):
         ...
 
 
+# --- monitoring --------------------------------------------------------------------------
+
+
+class StepProbe(Protocol):
+    """Reads what the safety monitor needs of a running scene: contact forces folded over
+    every physics substep of a control step, and a snapshot at its end. The monitor's
+    contact gate sets :attr:`scan` and :attr:`read_last` before each control step."""
+
+    scan: bool  # the coming control step's substeps scan the kept contact pairs
+    read_last: bool  # its snapshot reads the last substep's kept contacts
+
+    def reset(self) -> None:
+        """Forget what was folded in, and re-read the state (after the scene's reset)."""
+        ...
+
+    def record_substep(self) -> None:
+        """Fold the physics substep just taken into the control step's maxima."""
+        ...
+
+    def snapshot(self, step: int, time: float, *, contacts: bool = False) -> MonitorState:
+        """The world now, with the maxima folded in since the last snapshot."""
+        ...
+
+
+class MonitoredScene(Protocol):
+    """A running scene as the safety monitor reads it. Frames are named as in
+    ``fsvla.monitor.state``: a body, ``"<body>:<link>"``, ``"@<robot>:<link>"``."""
+
+    @property
+    def spec(self) -> SceneSpec: ...
+
+    def frames(self) -> Sequence[str]:
+        """Every frame the scene has."""
+        ...
+
+    def frame_shapes(self, frame: str) -> list[Shape]:
+        """A frame's collision shapes, in its own frame (the monitor's geometry of a robot
+        link)."""
+        ...
+
+    def probe(self, timestep: float, *, pose_frames: Sequence[str], free_bodies: Sequence[str],
+              torque_frames: Sequence[str], scan: ContactFilter, last: ContactFilter,
+              joints: Mapping[str, tuple[str, str]],
+              gravity: tuple[float, float, float]) -> StepProbe:
+        """A probe that reads ``pose_frames``' poses, the net contact force (and, for
+        ``torque_frames``, torque) of each free body in ``free_bodies`` from its velocity
+        change, the contact pairs ``scan`` keeps at every substep and those ``last`` keeps
+        at the last, and the joints ``joints`` maps (state name -> (body, joint); joints
+        the body lacks are left out)."""
+        ...
+
+
 # --- changing the look ------------------------------------------------------------------
 
 
@@ -245,5 +303,5 @@ class SceneAppearance(Protocol):
         ...
 
 
-__all__ = ["ArmModel", "Camera", "Color", "IKResult", "Light", "Material", "PoseReading",
-           "SceneAppearance", "SceneState", "Undo", "WorldPose"]
+__all__ = ["ArmModel", "Camera", "Color", "IKResult", "Light", "Material", "MonitoredScene",
+           "PoseReading", "SceneAppearance", "SceneState", "StepProbe", "Undo", "WorldPose"]

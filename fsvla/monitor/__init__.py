@@ -2,7 +2,8 @@
 dual-threshold states and soft costs, temporal precondition FSMs and the success timer,
 and the episode's ``fsvla.metrics`` trace. See ``docs/monitor.md``.
 
-Importing this package does not import SAPIEN; the probe imports it where it reads a scene.
+It names no simulator: it reads a scene through :class:`fsvla.world.MonitoredScene` and
+the :class:`fsvla.world.StepProbe` that makes (``fsvla.sim`` implements both for SAPIEN).
 """
 
 from .evaluator import Evaluator, channel_infos

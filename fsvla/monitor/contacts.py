@@ -5,10 +5,12 @@ bodies get a velocity-based net force (and torque) every substep and which conta
 the per-substep scan keeps; :func:`predicate_filter` the pairs the contact predicates
 read at a step's last substep. :class:`ContactGate` turns a scan off for the next
 control step while no robot link is within :data:`CONTACT_GATE` of a body its pairs
-could touch (see ``fsvla.monitor.probe``).
+could touch (see ``fsvla.sim.probe``).
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -20,11 +22,37 @@ from . import kernels
 from .geometry import SceneGeometry
 from .layout import Layout
 from .predicates import CONTACT_PREDICATES, spec_conditions
-from .probe import ContactFilter
 
 #: Broad-phase distance (m) within which robot links' contacts are scanned.
 CONTACT_GATE = 0.1
 FORCE_METRICS = frozenset({"contact_force", "contact_torque"})
+
+
+def _robot_of(frame: str | None) -> str | None:
+    return frame.split(":", 1)[0] if frame and frame.startswith("@") else None
+
+
+@dataclass(frozen=True)
+class ContactFilter:
+    """Which contact pairs a reading keeps."""
+
+    any_pair: frozenset[str] = frozenset()  # frames whose every contact counts
+    robot_pairs: frozenset[str] = frozenset()  # frames whose contacts with a robot link count
+
+    def __bool__(self) -> bool:
+        return bool(self.any_pair or self.robot_pairs)
+
+    @property
+    def frames(self) -> frozenset[str]:
+        """The frames one of which every kept pair involves."""
+        return self.any_pair | self.robot_pairs
+
+    def wants(self, f0: str | None, f1: str | None) -> bool:
+        if f0 in self.any_pair or f1 in self.any_pair:
+            r0 = _robot_of(f0)
+            return r0 is None or r0 != _robot_of(f1)  # not a robot's own links
+        return ((f0 in self.robot_pairs and f1 is not None and f1[0] == "@")
+                or (f1 in self.robot_pairs and f0 is not None and f0[0] == "@"))
 
 
 def contact_plan(spec: MonitorSpec, layout: Layout, scene_spec: SceneSpec) -> tuple[
@@ -107,4 +135,5 @@ class ContactGate:
         return scan, last
 
 
-__all__ = ["CONTACT_GATE", "FORCE_METRICS", "ContactGate", "contact_plan", "predicate_filter"]
+__all__ = ["CONTACT_GATE", "FORCE_METRICS", "ContactFilter", "ContactGate", "contact_plan",
+           "predicate_filter"]

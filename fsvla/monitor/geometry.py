@@ -2,8 +2,8 @@
 
 Every frame (a rigid body, an articulated body's link, a robot link, a zone) owns FCL
 pieces built by ``fsvla.compiler.collision.pieces_of`` from compiler ``Shape`` models:
-bodies and zones from the SceneSpec, robot links from their SAPIEN collision shapes
-(:func:`shapes_of_sapien`). Each step :meth:`SceneGeometry.set_poses` moves the world
+bodies and zones from the SceneSpec, robot links from the shapes the simulator gives
+(``MonitoredScene.frame_shapes``). Each step :meth:`SceneGeometry.set_poses` moves the world
 axis-aligned bounds of every piece, and of every frame (the box around its pieces), in
 one compiled pass (``fsvla.monitor.kernels``); FCL transforms are set lazily, only for
 pieces an exact query touches. :meth:`SceneGeometry.prefetch` gives each distance query
@@ -27,24 +27,16 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from fsvla.compiler.assets.geometry import shape_aabb, shape_to_trimesh
 from fsvla.compiler.assets.model import (
-    BoxShape,
-    CapsuleShape,
-    ConvexMeshShape,
-    CylinderShape,
-    InlineMesh,
-    Pose,
     Shape,
-    SphereShape,
 )
 from fsvla.compiler.collision import CollisionPiece, pieces_of, signed_distance
-from fsvla.compiler.pose import pose_matrix, quat_mul
+from fsvla.compiler.pose import pose_matrix
 
 from . import kernels
 from .state import Matrix4
@@ -57,39 +49,6 @@ POSE_TOLERANCE = 1e-5
 #: An exact FCL distance carried as a bound loses this much (m): FCL finds distances to 1e-6.
 CARRY_SLACK = 1e-5
 _POINT_SECTIONS = 12  # rim points of a round shape for footprint / lowest-point queries
-
-# SAPIEN capsules and cylinders lie along local x; ours (and FCL's) along local z.
-_Z_TO_X = (0.7071067811865476, 0.0, 0.7071067811865476, 0.0)
-
-
-def shapes_of_sapien(component: Any) -> list[Shape]:
-    """Compiler shapes for the collision shapes of a SAPIEN rigid component or link."""
-    import sapien
-
-    physx = sapien.physx
-    shapes: list[Shape] = []
-    for sh in component.collision_shapes:
-        local = sh.local_pose
-        p, q = tuple(float(v) for v in local.p), tuple(float(v) for v in local.q)
-        if isinstance(sh, physx.PhysxCollisionShapeBox):
-            shapes.append(BoxShape(pose=Pose(position=p, quaternion=q),
-                                   half_size=tuple(float(v) for v in sh.half_size)))
-        elif isinstance(sh, physx.PhysxCollisionShapeSphere):
-            shapes.append(SphereShape(pose=Pose(position=p, quaternion=q), radius=float(sh.radius)))
-        elif isinstance(sh, physx.PhysxCollisionShapeCapsule):
-            shapes.append(CapsuleShape(pose=Pose(position=p, quaternion=quat_mul(q, _Z_TO_X)),
-                                       radius=float(sh.radius), half_length=float(sh.half_length)))
-        elif isinstance(sh, physx.PhysxCollisionShapeCylinder):
-            shapes.append(CylinderShape(pose=Pose(position=p, quaternion=quat_mul(q, _Z_TO_X)),
-                                        radius=float(sh.radius), half_length=float(sh.half_length)))
-        elif isinstance(sh, physx.PhysxCollisionShapeConvexMesh):
-            vertices = np.asarray(sh.vertices, dtype=np.float64) * np.asarray(sh.scale, dtype=np.float64)
-            faces = np.asarray(sh.get_triangles(), dtype=np.int64)
-            shapes.append(ConvexMeshShape(pose=Pose(position=p, quaternion=q), mesh=InlineMesh(
-                vertices=[tuple(v) for v in vertices.tolist()], faces=[tuple(f) for f in faces.tolist()])))
-        # planes and triangle meshes are not monitored (the floor; never a robot link)
-    return shapes
-
 
 def _local_points(shape: Shape, base_dir: Path | None) -> NDArray[np.float64]:
     if shape.type == "convex_mesh" and shape.mesh.type == "file":
@@ -571,4 +530,4 @@ class StepSampler:
         obj.setTranslation(geo._translations[p])
         geo._placed[p] = -1  # placed at its frame's pose again when next used
 
-__all__ = ["MAX_DISTANCE", "POSE_TOLERANCE", "SceneGeometry", "StepSampler", "shapes_of_sapien"]
+__all__ = ["MAX_DISTANCE", "POSE_TOLERANCE", "SceneGeometry", "StepSampler"]

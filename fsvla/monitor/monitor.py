@@ -1,4 +1,4 @@
-"""SafetyMonitor: the runtime safety monitor of a built SAPIEN scene (paper §4).
+"""SafetyMonitor: the runtime safety monitor of a built scene (paper §4).
 
 An env drives it in this order (dm_control's hooks: episode init, after substep, after step)::
 
@@ -10,11 +10,11 @@ An env drives it in this order (dm_control's hooks: episode init, after substep,
         report = monitor.end_step()                  # margins, states, costs, success
     trace = monitor.trace(meta)                      # an fsvla.metrics EpisodeTrace
 
-``built`` is anything with ``spec`` (SceneSpec), ``scene`` (sapien.Scene), ``bodies``
-(name -> sapien.Entity), ``articulations`` (name -> PhysxArticulation) and ``robot``
-(a LoadedRobot), as ``fsvla.sim.build`` returns.
+``built`` is a :class:`fsvla.world.MonitoredScene` (``fsvla.sim.build`` returns one): the
+monitor reads it only through the frames it names, their collision shapes, and the
+:class:`fsvla.world.StepProbe` it makes for the channels' needs.
 
-Contact scanning (see ``fsvla.monitor.probe``) is gated per control step: when the
+Contact scanning (see ``fsvla.sim.probe``) is gated per control step: when the
 per-pair scan only concerns robot links, it runs in a control step only if, at the end
 of the previous one, a robot link's bounds lay within :data:`CONTACT_GATE` of another
 body's bounds. A link moving slower than 2 m/s travels less than that in one 50 ms
@@ -23,69 +23,46 @@ control step, and PhysX makes no contact beyond its contact offset (4 mm).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import Any
 
 from fsvla.compiler.monitor import MonitorSpec, RobotEntity
-from fsvla.compiler.scene import SceneSpec
 from fsvla.metrics.trace import EpisodeMeta, EpisodeTrace
 from fsvla.run.key import EpisodeKey
+from fsvla.world import MonitoredScene
 
-from .contacts import CONTACT_GATE, ContactGate, contact_plan, predicate_filter
+from .contacts import CONTACT_GATE, ContactFilter, ContactGate, contact_plan, predicate_filter
 from .evaluator import Evaluator
-from .geometry import shapes_of_sapien
 from .layout import build_geometry, build_layout
 from .predicates import uses_contacts
-from .probe import ContactFilter, Probe, components_of
 from .report import StepReport
-from .state import link_frame
 
 
 class SafetyMonitor:
     """Monitors one built scene: per-substep forces, per-step margins, an episode trace."""
 
-    def __init__(self, spec: MonitorSpec, built: Any):
-        robots = dict(built.robot.articulations) if getattr(built, "robot", None) is not None else {}
-        self._init(spec, built.spec, built.scene, dict(built.bodies), dict(built.articulations), robots)
-
-    @classmethod
-    def from_parts(cls, spec: MonitorSpec, scene_spec: SceneSpec, scene: Any, bodies: Mapping[str, Any],
-                   articulations: Mapping[str, Any] | None = None,
-                   robots: Mapping[str, Any] | None = None) -> SafetyMonitor:
-        """A monitor over a scene built by hand (tests, other builders)."""
-        monitor = cls.__new__(cls)
-        monitor._init(spec, scene_spec, scene, dict(bodies), dict(articulations or {}), dict(robots or {}))
-        return monitor
-
-    def _init(self, spec: MonitorSpec, scene_spec: SceneSpec, scene: Any, bodies: dict[str, Any],
-              articulations: dict[str, Any], robots: dict[str, Any]) -> None:
+    def __init__(self, spec: MonitorSpec, built: MonitoredScene):
         self.spec = spec
+        scene_spec = built.spec
         layout = build_layout(spec, scene_spec)
-        components = components_of(bodies, articulations, robots)
+        frames = set(built.frames())
         free, torque, scan = contact_plan(spec, layout, scene_spec)
         robot_frames = set().union(*(layout.frames(e.name) for e in spec.entities if isinstance(e, RobotEntity)),
                                    *(a.gripper for a in layout.arms.values()))
         last = predicate_filter(spec, layout) if uses_contacts(spec) else ContactFilter()
         if scan.robot_pairs or last.robot_pairs:  # the gates need every robot link's bounds
-            robot_frames |= {f for f in components if f.startswith("@")}
-        robot_shapes = {f: shapes_of_sapien(components[f]) for f in sorted(robot_frames) if f in components}
+            robot_frames |= {f for f in frames if f.startswith("@")}
+        robot_shapes = {f: built.frame_shapes(f) for f in sorted(robot_frames) if f in frames}
         self.geometry = build_geometry(scene_spec, layout, robot_shapes)
         self.evaluator = Evaluator(spec, layout, self.geometry)
         pose_frames = set(layout.moving_frames()) | robot_frames
         for body in layout.bodies.values():  # every moving body, for the contact gate
             if not body.is_static or body.articulated:
                 pose_frames |= body.frames
-        joints = {}
-        for name, articulation in articulations.items():
-            body = layout.bodies.get(name)
-            names = [j.name for j in articulation.active_joints]
-            for part in body.parts if body is not None else ():
-                joint = part.joint.split(":", 1)[1]
-                if joint in names:
-                    joints[link_frame(name, joint)] = (articulation, names.index(joint))
-        self.probe = Probe(scene, spec.timestep, components, pose_frames=sorted(pose_frames),
-                           free_bodies=sorted(free), torque_frames=sorted(torque), scan=scan, last=last,
-                           joints=joints, gravity=tuple(scene_spec.physics.gravity))
+        joints = {part.joint: (body.name, part.joint.split(":", 1)[1])  # "<body>:<joint>"
+                  for body in layout.bodies.values() if body.articulated for part in body.parts}
+        self.probe = built.probe(spec.timestep, pose_frames=sorted(pose_frames), free_bodies=sorted(free),
+                                 torque_frames=sorted(torque), scan=scan, last=last, joints=joints,
+                                 gravity=tuple(scene_spec.physics.gravity))
         self._gate = ContactGate(self.geometry, scan, last) if scan or last else None
         self._step = 0
 

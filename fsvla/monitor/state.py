@@ -1,7 +1,8 @@
 """A plain snapshot of the world at the end of one control step.
 
-The probe (``fsvla.monitor.probe``) fills it from a SAPIEN scene; channels and predicates
-read only this, so they can be tested on hand-made snapshots with no simulator.
+A :class:`fsvla.world.StepProbe` (``fsvla.sim.probe`` for SAPIEN) fills it from a running
+scene; channels and predicates read only this, so they can be tested on hand-made
+snapshots with no simulator.
 
 Frames are named by string:
 

@@ -21,10 +21,10 @@ from __future__ import annotations
 
 import contextlib
 import tempfile
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,8 +45,14 @@ from .render import (
     picture_rgb,
 )
 from .robot import LoadedRobot, load_robot
-from .shapes import collision_shapes, physx_material, sapien_pose, visual_shapes
+from .shapes import collision_shapes, physx_material, sapien_pose, shapes_of_sapien, visual_shapes
 from .urdf import prepare_urdf
+
+if TYPE_CHECKING:
+    from fsvla.compiler.assets.model import Shape
+    from fsvla.monitor.contacts import ContactFilter
+
+    from .probe import Probe
 
 #: PhysX solver iterations (position, velocity) of each free rigid body: SAPIEN's
 #: defaults, set per body so that a changed global body config cannot alter a scene.
@@ -60,8 +66,8 @@ FLOOR_COLOR = (0.55, 0.55, 0.52, 1.0)
 @dataclass
 class BuiltScene:
     """A SceneSpec built in SAPIEN; names are the spec's. It is the SAPIEN back-end's
-    :class:`fsvla.world.SceneState`, and :meth:`appearance` its
-    :class:`fsvla.world.SceneAppearance`."""
+    :class:`fsvla.world.MonitoredScene` and :class:`fsvla.world.SceneState`, and
+    :meth:`appearance` its :class:`fsvla.world.SceneAppearance`."""
 
     spec: SceneSpec
     scene: Any  # sapien.Scene
@@ -71,6 +77,8 @@ class BuiltScene:
     cameras: dict[str, Any] = field(default_factory=dict)  # name -> RenderCameraComponent
     zones: dict[str, Any] = field(default_factory=dict)  # zone name -> marker/walls entity
     ground: Any = None
+    _frame_components: dict[str, Any] = field(default_factory=dict, init=False, repr=False,
+                                              compare=False)
 
     @property
     def renders(self) -> bool:
@@ -167,6 +175,38 @@ class BuiltScene:
 
     def arm_model(self, arm: str) -> ArmKinematics:
         return ArmKinematics(self.robot.arm(arm))
+
+    # --- fsvla.world.MonitoredScene: what the safety monitor reads -------------------------
+    def frames(self) -> list[str]:
+        return list(self._components())
+
+    def frame_shapes(self, frame: str) -> list[Shape]:
+        return shapes_of_sapien(self._components()[frame])
+
+    def probe(self, timestep: float, *, pose_frames: Sequence[str], free_bodies: Sequence[str],
+              torque_frames: Sequence[str], scan: ContactFilter, last: ContactFilter,
+              joints: Mapping[str, tuple[str, str]],
+              gravity: tuple[float, float, float]) -> Probe:
+        from .probe import Probe
+
+        indices = {}  # state name -> (articulation, index in its qpos)
+        for name, (body, joint) in joints.items():
+            articulation = self.articulations.get(body)
+            names = [j.name for j in articulation.active_joints] if articulation is not None else []
+            if joint in names:
+                indices[name] = (articulation, names.index(joint))
+        return Probe(self.scene, timestep, self._components(), pose_frames=pose_frames,
+                     free_bodies=free_bodies, torque_frames=torque_frames, scan=scan, last=last,
+                     joints=indices, gravity=gravity)
+
+    def _components(self) -> dict[str, Any]:
+        """Frame name -> SAPIEN rigid component or link (made once: the parts are fixed)."""
+        if not self._frame_components:
+            from .probe import components_of
+
+            self._frame_components = components_of(self.bodies, self.articulations,
+                                                   self.robot.articulations)
+        return self._frame_components
 
     # --- fsvla.world.SceneAppearance: what the visual variation changes ---------------------
     def appearance(self) -> SapienAppearance:

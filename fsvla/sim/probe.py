@@ -1,5 +1,7 @@
 """Read a :class:`~fsvla.monitor.state.WorldState` from a SAPIEN scene, through SAPIEN's
-public API only (``get_contacts()``, poses, velocities, masses and inertia).
+public API only (``get_contacts()``, poses, velocities, masses and inertia): the SAPIEN
+back-end's :class:`fsvla.world.StepProbe`, which ``BuiltScene.probe`` makes for the
+safety monitor.
 
 Contact forces are read at **every** physics substep (a spike inside a control step is
 never missed), two ways:
@@ -11,7 +13,7 @@ never missed), two ways:
   two velocity reads, where its resting contacts would cost microseconds a point. It is
   recorded as the pair (body, ``"*"``).
 - **Per-pair contact forces** from ``get_contacts()`` for the pairs a channel needs
-  (:class:`ContactFilter`): every pair of a watched robot link or articulated link, and
+  (:class:`~fsvla.monitor.contacts.ContactFilter`): every pair of a watched robot link or articulated link, and
   robot-link pairs of watched objects (a squeeze, whose net force is zero). Contacts
   between two links of one robot are skipped, and only kept contacts' points are read.
   The scan runs in a control step only while :attr:`Probe.scan` is set (the monitor
@@ -30,14 +32,23 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from .state import NET, ContactMaxima, PoseMap, WorldState, link_frame, pair_key, robot_frame
+from fsvla.monitor.contacts import ContactFilter
+from fsvla.monitor.state import (
+    NET,
+    ContactMaxima,
+    PoseMap,
+    WorldState,
+    link_frame,
+    pair_key,
+    robot_frame,
+)
 
 _ZERO = [0.0, 0.0, 0.0]
+NO_PAIRS = ContactFilter()  # a filter that keeps no contact
 Records = list[tuple[str, str, str, float]]  # (kind "f" or "t", frame, other, value)
 
 
@@ -63,33 +74,6 @@ def components_of(bodies: Mapping[str, Any], articulations: Mapping[str, Any],
         for link in articulation.links:
             frames[robot_frame(name, link.name)] = link
     return frames
-
-
-def _robot_of(frame: str | None) -> str | None:
-    return frame.split(":", 1)[0] if frame and frame.startswith("@") else None
-
-
-@dataclass(frozen=True)
-class ContactFilter:
-    """Which contact pairs a reading keeps."""
-
-    any_pair: frozenset[str] = frozenset()  # frames whose every contact counts
-    robot_pairs: frozenset[str] = frozenset()  # frames whose contacts with a robot link count
-
-    def __bool__(self) -> bool:
-        return bool(self.any_pair or self.robot_pairs)
-
-    @property
-    def frames(self) -> frozenset[str]:
-        """The frames one of which every kept pair involves."""
-        return self.any_pair | self.robot_pairs
-
-    def wants(self, f0: str | None, f1: str | None) -> bool:
-        if f0 in self.any_pair or f1 in self.any_pair:
-            r0 = _robot_of(f0)
-            return r0 is None or r0 != _robot_of(f1)  # not a robot's own links
-        return ((f0 in self.robot_pairs and f1 is not None and f1[0] == "@")
-                or (f1 in self.robot_pairs and f0 is not None and f0[0] == "@"))
 
 
 class _FreeBody:
@@ -186,8 +170,8 @@ class Probe:
 
     def __init__(self, scene: Any, timestep: float, components: Mapping[str, Any], *,
                  pose_frames: Iterable[str] = (), free_bodies: Iterable[str] = (),
-                 torque_frames: Iterable[str] = (), scan: ContactFilter = ContactFilter(),
-                 last: ContactFilter = ContactFilter(),
+                 torque_frames: Iterable[str] = (), scan: ContactFilter = NO_PAIRS,
+                 last: ContactFilter = NO_PAIRS,
                  joints: Mapping[str, tuple[Any, int]] | None = None,
                  gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)):
         self._physx = getattr(scene, "physx_system", scene)
@@ -447,4 +431,4 @@ def _add_moment(torques: dict[tuple[str, str], list[float]], key: tuple[str, str
     moment[2] += sign * (rx * iy - ry * ix)
 
 
-__all__ = ["NET", "ContactFilter", "Probe", "components_of"]
+__all__ = ["Probe", "components_of"]

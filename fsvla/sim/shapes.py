@@ -1,7 +1,10 @@
-"""Asset geometry (``fsvla.compiler.assets.model``) to SAPIEN collision and render shapes.
+"""Asset geometry (``fsvla.compiler.assets.model``) to SAPIEN collision and render shapes,
+and SAPIEN collision shapes back to asset shapes (:func:`shapes_of_sapien`: robot links,
+for the monitor's geometry).
 
 Frames: an asset's cylinders and capsules have their axis along local z, SAPIEN's along
-local x, so each gets the rotation :data:`Z_TO_X` appended to its pose. Inline meshes
+local x, so each gets the rotation :data:`Z_TO_X` appended to its pose (and
+:data:`X_TO_Z` on the way back). Inline meshes
 become SAPIEN shapes directly (no files); file meshes are loaded by SAPIEN from their
 path, scaled.
 """
@@ -15,15 +18,24 @@ import numpy as np
 
 from fsvla.compiler.assets.model import (
     Appearance,
+    BoxShape,
+    CapsuleShape,
+    ConvexMeshShape,
+    CylinderShape,
     InlineMesh,
     Material,
     MeshFile,
     Pose,
+    Shape,
+    SphereShape,
     VisualPart,
 )
+from fsvla.compiler.pose import quat_mul
 
 #: (w, x, y, z) of the rotation that takes SAPIEN's cylinder/capsule axis (+x) onto +z.
 Z_TO_X = (0.7071067811865476, 0.0, -0.7071067811865476, 0.0)
+#: Its inverse: appended to a SAPIEN cylinder's or capsule's pose, its axis lies along +z.
+X_TO_Z = (0.7071067811865476, 0.0, 0.7071067811865476, 0.0)
 
 #: Visual normals are split where faces meet at more than this angle (rad).
 SMOOTH_ANGLE = np.radians(35.0)
@@ -140,7 +152,36 @@ def visual_shapes(visuals: Iterable[VisualPart], default_look: Appearance | Mate
     return out
 
 
+def shapes_of_sapien(component: Any) -> list[Shape]:
+    """Asset shapes for the collision shapes of a SAPIEN rigid component or link."""
+    import sapien
+
+    physx = sapien.physx
+    shapes: list[Shape] = []
+    for sh in component.collision_shapes:
+        local = sh.local_pose
+        p, q = tuple(float(v) for v in local.p), tuple(float(v) for v in local.q)
+        if isinstance(sh, physx.PhysxCollisionShapeBox):
+            shapes.append(BoxShape(pose=Pose(position=p, quaternion=q),
+                                   half_size=tuple(float(v) for v in sh.half_size)))
+        elif isinstance(sh, physx.PhysxCollisionShapeSphere):
+            shapes.append(SphereShape(pose=Pose(position=p, quaternion=q), radius=float(sh.radius)))
+        elif isinstance(sh, physx.PhysxCollisionShapeCapsule):
+            shapes.append(CapsuleShape(pose=Pose(position=p, quaternion=quat_mul(q, X_TO_Z)),
+                                       radius=float(sh.radius), half_length=float(sh.half_length)))
+        elif isinstance(sh, physx.PhysxCollisionShapeCylinder):
+            shapes.append(CylinderShape(pose=Pose(position=p, quaternion=quat_mul(q, X_TO_Z)),
+                                        radius=float(sh.radius), half_length=float(sh.half_length)))
+        elif isinstance(sh, physx.PhysxCollisionShapeConvexMesh):
+            vertices = np.asarray(sh.vertices, dtype=np.float64) * np.asarray(sh.scale, dtype=np.float64)
+            faces = np.asarray(sh.get_triangles(), dtype=np.int64)
+            shapes.append(ConvexMeshShape(pose=Pose(position=p, quaternion=q), mesh=InlineMesh(
+                vertices=[tuple(v) for v in vertices.tolist()], faces=[tuple(f) for f in faces.tolist()])))
+        # planes and triangle meshes are not monitored (the floor; never a robot link)
+    return shapes
+
+
 __all__ = [
-    "Z_TO_X", "collision_shapes", "physx_material", "render_material", "sapien_pose",
-    "triangle_mesh_shape", "visual_shapes",
+    "X_TO_Z", "Z_TO_X", "collision_shapes", "physx_material", "render_material", "sapien_pose",
+    "shapes_of_sapien", "triangle_mesh_shape", "visual_shapes",
 ]

@@ -1,7 +1,7 @@
 """Sleeping guard bodies spare contact readings without changing a single number.
 
 The probe skips a substep's contact scan (and reuses the last substep's contacts for the
-predicates) while every body its kept pairs must involve sleeps (``fsvla.monitor.probe``).
+predicates) while every body its kept pairs must involve sleeps (``fsvla.sim.probe``).
 Here each built-in scenario runs the benchmark's ``reach`` and ``sweep`` motions with two
 monitors on one scene, one with the guards and one reading every contact; their force
 maxima, last-substep contacts and margins must be bit-identical at every control step.

@@ -23,7 +23,7 @@ import fsvla
 from fsvla.library import builtin_scenarios
 from fsvla.monitor import kernels
 from fsvla.monitor.channels import EXACT_BAND, TOUCH_DEPTH
-from fsvla.monitor.geometry import MAX_DISTANCE, POSE_TOLERANCE, shapes_of_sapien
+from fsvla.monitor.geometry import MAX_DISTANCE, POSE_TOLERANCE
 from fsvla.monitor.layout import build_geometry
 from fsvla.sim.kinematics import ArmKinematics
 
@@ -117,7 +117,7 @@ def test_distance_margins_match_brute_force(name):
     layout, geometry = monitor.evaluator.layout, monitor.geometry
     robot_frames = [f for f in geometry.frames if f.startswith("@")]
     fresh = build_geometry(env.scene_spec, layout,
-                           {f: shapes_of_sapien(monitor.probe.components[f]) for f in robot_frames})
+                           {f: env.built.frame_shapes(f) for f in robot_frames})
     states = []
     step = monitor.evaluator.step
     monitor.evaluator.step = lambda state: (states.append(state), step(state))[1]

@@ -13,9 +13,11 @@ from fsvla.compiler.scene import lower_scene
 from fsvla.dsl.loader import ScenarioLoader
 
 from fsvla.monitor import SafetyMonitor
-from fsvla.monitor.geometry import SceneGeometry, shapes_of_sapien
-from fsvla.monitor.probe import NET, ContactFilter, Probe
-from fsvla.monitor.state import pair_key
+from fsvla.monitor.contacts import ContactFilter
+from fsvla.monitor.geometry import SceneGeometry
+from fsvla.monitor.state import NET, pair_key
+from fsvla.sim.probe import Probe
+from fsvla.sim.shapes import shapes_of_sapien
 from tests.conftest import require_sapien
 
 sapien = require_sapien()
