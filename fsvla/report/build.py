@@ -22,6 +22,7 @@ from fsvla.report.tables import (
     derived,
     group_table,
     overall_statements,
+    severity_table,
 )
 
 #: Group tables in the order a report shows them.
@@ -36,7 +37,7 @@ class Report(BaseModel):
     protocol: Protocol
     aggregate: AggregateTable  # Table 2
     groups: dict[str, GroupTable]  # Table 3 (suite), per category, per embodiment
-    severity: dict[str, GroupTable]  # Fig. 4: per level of L, W and V
+    severity: dict[str, GroupTable]  # Fig. 4: per level of L, W and V (severity_table)
     derived: tuple[Derived, ...]  # §5.2, per policy
     statements: tuple[str, ...]  # §5.2, across policies
     dissection: Dissection | None  # Fig. 5 / Table 4
@@ -52,7 +53,7 @@ def build_report(runs: Sequence[RunData], *, episode: str | None = None,
     settings = settings or Settings()
     table = aggregate_table(runs, settings)
     groups = {by: group_table(runs, by, settings) for by in GROUPINGS}
-    severity = {by: group_table(runs, by, settings) for by in SEVERITY_DIMENSIONS}
+    severity = {by: severity_table(runs, by, settings) for by in SEVERITY_DIMENSIONS}
     return Report(
         protocol=protocol(runs, settings), aggregate=table, groups=groups, severity=severity,
         derived=tuple(derived(r, settings.confidence) for r in runs),

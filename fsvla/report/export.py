@@ -54,6 +54,8 @@ def group_records(table: GroupTable) -> list[Record]:
             record: Record = {table.by: row.key, "label": row.label, "section": row.section,
                               "policy": policy, "n": 0 if cell is None else cell.n,
                               "n_layouts": 0 if cell is None else cell.n_layouts}
+            if table.by in ("level", "language", "vision"):
+                record["protocol"] = None if cell is None else cell.protocol
             for name in ("ssr", "cc", "sasr"):
                 record.update(_interval(name, None if cell is None else getattr(cell, name)))
             out.append(record)

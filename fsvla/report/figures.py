@@ -3,7 +3,9 @@ backend change, no display needed).
 
 * :func:`landscape`  Fig. 3: SSR against CC per policy, bubble area ∝ USR, CIs as bars.
 * :func:`diagnosis`  Fig. 4: SSR (solid, left axis) and CC (dashed, right axis) against
-  severity for L, W and V, one colour per policy, adversarial levels shaded.
+  severity for L, W and V, one colour per policy, adversarial levels shaded; a filled
+  marker is a one-axis point (the other two dimensions at L0/W0/V0, as ``--sweep`` runs
+  them), a hollow one a point pooled over the other two dimensions.
 * :func:`margins`    Fig. 5 (bottom): q_k(t) per channel with its warning band [0, ε_k)
   and the hard threshold 0.
 * :func:`keyframes`  Fig. 5 (top): the episode's keyframes, when a video was recorded.
@@ -29,6 +31,7 @@ if TYPE_CHECKING:
 FIGURE_FORMATS = ("png", "pdf", "svg")
 _DIMENSION_TITLES = {"level": "(a) Structure / layout (L)", "language": "(b) Language (W)",
                      "vision": "(c) Vision (V)"}
+_PROTOCOL_TITLES = {"level": " at W0/V0", "language": " at L0/V0", "vision": " at L0/W0"}
 _WARNING = "#f2c14e"
 SYMLOG_SPAN = 20  # margins reaching past this many ε_k are drawn on a symlog axis
 _VIOLATION = "#d1495b"
@@ -129,17 +132,29 @@ def diagnosis(report: Report) -> Figure:
             i = levels.index(level)
             ax.axvspan(i - 0.5, i + 0.5, color=_VIOLATION, alpha=0.1, lw=0)
         cc_ax = ax.twinx()
+        pooled = False
         for policy in table.policies:
             points = [(levels.index(row.key), row.cells[policy]) for row in table.rows
                       if row.cells.get(policy) is not None]
             xs = [x for x, _ in points]
-            ax.plot(xs, [c.ssr.estimate for _, c in points], "-o", color=colour[policy],
-                    markersize=4, label=_plain(policy))
-            cc_ax.plot(xs, [c.cc.estimate for _, c in points], "--s", color=colour[policy],
-                       markersize=3, alpha=0.8)
+            ax.plot(xs, [c.ssr.estimate for _, c in points], "-", color=colour[policy],
+                    label=_plain(policy))
+            cc_ax.plot(xs, [c.cc.estimate for _, c in points], "--", color=colour[policy],
+                       alpha=0.8)
+            for x, cell in points:
+                face = colour[policy] if cell.protocol != "pooled" else "white"
+                pooled = pooled or cell.protocol == "pooled"
+                ax.plot([x], [cell.ssr.estimate], "o", color=colour[policy], markersize=4,
+                        markerfacecolor=face)
+                cc_ax.plot([x], [cell.cc.estimate], "s", color=colour[policy], markersize=3,
+                           markerfacecolor=face, alpha=0.8)
         ax.set_ylim(-0.03, 1.05)  # a little below 0, so that lines at 0 stay visible
         cc_ax.set_ylim(-0.03 / 1.08 * cc_top, cc_top)
-        ax.set_title(_DIMENSION_TITLES[dimension], fontsize=10)
+        ax.set_title(_DIMENSION_TITLES[dimension] + ("" if pooled else _PROTOCOL_TITLES[dimension]),
+                     fontsize=10)
+        if pooled:
+            ax.text(0.02, 0.02, "hollow: pooled over the other two", transform=ax.transAxes,
+                    fontsize=7, color="0.3")
         ax.set_ylabel("SSR (solid)")
         cc_ax.set_ylabel("CC (dashed)")
         ax.grid(alpha=0.3)

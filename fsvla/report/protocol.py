@@ -31,7 +31,8 @@ INTERVALS = ("they count distinct layouts, not episodes: Wilson for rates with n
 LAYOUT_PROTOCOLS = {1: "one per run seed (results schema 1)",
                     2: "one per episode: SHA-256 of (run seed, episode index); L0 jittered"}
 #: Protocol fields compared across runs (their values should agree for a fair comparison).
-COMPARED = ("scenario_names", "levels", "languages", "visions", "episodes_per_cell", "seeds",
+COMPARED = ("scenario_names", "levels", "languages", "visions", "sweep", "episodes_per_cell",
+            "seeds",
             "layout_protocol", "warmup", "sasr_lambda", "control_mode", "obs_mode", "terminate_on_violation")
 
 
@@ -50,6 +51,8 @@ class RunProtocol(BaseModel):
     levels: tuple[str, ...]
     languages: tuple[str, ...]
     visions: tuple[str, ...]
+    sweep: bool  # one-axis sweeps (fsvla run --sweep), not the grid
+    cells_per_scenario: int
     episodes_per_cell: int
     seeds: tuple[int, ...]  # run seeds
     layout_protocol: str  # how the layouts were drawn (LAYOUT_PROTOCOLS)
@@ -108,6 +111,7 @@ def run_protocol(run: RunData) -> RunProtocol:
         suites=tuple(sorted({k.suite for k in keys})),
         embodiments=tuple(sorted({k.embodiment for k in keys})),
         levels=config.levels, languages=config.languages, visions=config.visions,
+        sweep=config.sweep, cells_per_scenario=len(config.cells()),
         episodes_per_cell=config.episodes, seeds=config.seeds,
         layout_protocol=LAYOUT_PROTOCOLS.get(run.info.schema_version, "unknown"),
         layouts_scored=_layouts(run), warmup=config.warmup,

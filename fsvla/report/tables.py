@@ -15,6 +15,7 @@ CC / (T · Σ_k w_k) as ``cc_weighted``. SASR is computed from the episodes at t
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict
 
@@ -30,7 +31,7 @@ from fsvla.metrics import (
 from fsvla.metrics.taxonomy import CATEGORY_BY_ID, SUITE_CATEGORY
 from fsvla.metrics.trace import SUITES
 from fsvla.report.data import RunData
-from fsvla.run.config import LANGUAGES, LEVELS, VISIONS
+from fsvla.run.config import LANGUAGES, LEVELS, ORIGIN, VISIONS
 
 #: Which way is better for each metric of Table 2 (None: neither, as SFR in the paper).
 BETTER: dict[str, str | None] = {"ssr": "high", "usr": "low", "sfr": None, "ufr": "low",
@@ -44,6 +45,10 @@ ADVERSARIAL: dict[str, tuple[str, ...]] = {"level": (), "language": ("W3", "W4")
 SEVERITY_DIMENSIONS: dict[str, tuple[str, ...]] = {"level": LEVELS, "language": LANGUAGES,
                                                    "vision": VISIONS}
 _TIE = 1e-12
+#: Where a Fig. 4 point comes from: the one-axis cell (the other two dimensions at
+#: L0/W0/V0, as ``fsvla run --sweep`` plans them), or every episode at the level, pooled
+#: over the other two dimensions (when the run has no one-axis cell there).
+PointProtocol = Literal["sweep", "pooled"]
 
 
 class Settings(BaseModel):
@@ -98,6 +103,7 @@ class GroupCell(BaseModel):
     ssr: Interval
     cc: Interval
     sasr: Interval
+    protocol: PointProtocol | None = None  # Fig. 4's tables: where the point comes from
 
 
 class GroupRow(BaseModel):
@@ -173,9 +179,9 @@ def aggregate_table(runs: Sequence[RunData], settings: Settings | None = None) -
     return AggregateTable(rows=tuple(rows), best=best)
 
 
-def _cell(agg: Aggregate) -> GroupCell:
+def _cell(agg: Aggregate, protocol: PointProtocol | None = None) -> GroupCell:
     return GroupCell(n=agg.n, n_layouts=agg.n_layouts, ssr=agg.ssr, cc=agg.cc_per_step,
-                     sasr=agg.sasr)
+                     sasr=agg.sasr, protocol=protocol)
 
 
 def _suite_label(suite: str) -> str:
@@ -221,6 +227,43 @@ def group_table(runs: Sequence[RunData], by: str, settings: Settings | None = No
         rows.append(GroupRow(key=key, label=label, section=section, cells=cells, best=best))
     return GroupTable(by=by, title=_TITLES.get(by, f"Per {by}"), policies=tuple(per_policy),
                       rows=tuple(rows))
+
+
+_DIMENSION_AXES = {"level": 0, "language": 1, "vision": 2}
+
+
+def _on_axis(episode: EpisodeMetrics, by: str) -> bool:
+    """Whether the episode lies on ``by``'s one-axis sweep: the other two at the origin."""
+    key = episode.meta.key
+    levels = (key.level, key.language, key.vision)
+    return all(levels[i] == ORIGIN[i] for i in range(3) if i != _DIMENSION_AXES[by])
+
+
+def severity_table(runs: Sequence[RunData], by: str,
+                   settings: Settings | None = None) -> GroupTable:
+    """Fig. 4 along ``by`` (level, language or vision): for each run and each level, the
+    episodes of its one-axis cell when the run has any (protocol ``sweep``), else all its
+    episodes at that level, pooled over the other two dimensions (``pooled``)."""
+    settings = settings or Settings()
+    per_policy: dict[str, dict[str, GroupCell]] = {}
+    for run in runs:
+        cells: dict[str, GroupCell] = {}
+        for value in SEVERITY_DIMENSIONS[by]:
+            at = [m for m in run.metrics if getattr(m.meta.key, by) == value]
+            on_axis = [m for m in at if _on_axis(m, by)]
+            if at:
+                protocol: PointProtocol = "sweep" if on_axis else "pooled"
+                chosen = on_axis or at
+                cells[value] = _cell(_aggregate(chosen, run.sasr_lambda, settings), protocol)
+        per_policy[run.label] = cells
+    rows = []
+    for key, label, section in _row_keys(by, {k for cells in per_policy.values() for k in cells}):
+        cells = {p: c.get(key) for p, c in per_policy.items()}
+        present = {p: c for p, c in cells.items() if c is not None}
+        best = {m: _best({p: getattr(c, m).estimate for p, c in present.items()}, BETTER[m])
+                for m in GROUP_METRICS}
+        rows.append(GroupRow(key=key, label=label, section=section, cells=cells, best=best))
+    return GroupTable(by=by, title=_TITLES[by], policies=tuple(per_policy), rows=tuple(rows))
 
 
 def _percent(interval: Interval | None) -> str:
@@ -291,4 +334,5 @@ def overall_statements(table: AggregateTable, suites: GroupTable) -> list[str]:
 
 __all__ = ["ADVERSARIAL", "BETTER", "GROUP_METRICS", "METRIC_NAMES", "SEVERITY_DIMENSIONS",
            "AggregateRow", "AggregateTable", "Derived", "GroupCell", "GroupRow", "GroupTable",
-           "Settings", "aggregate_table", "derived", "group_table", "overall_statements"]
+           "PointProtocol", "Settings", "aggregate_table", "derived", "group_table",
+           "overall_statements", "severity_table"]

@@ -103,11 +103,18 @@ def group_view(table: GroupTable, ci: bool = False) -> TextTable:
                 continue
             cells += [metric_cell(getattr(cell, m), policy in row.best[m], ci)
                       for m in GROUP_METRICS]
-            cells.append(Cell(f"{cell.n} ({cell.n_layouts})", cell.n))
+            pooled = "*" if cell.protocol == "pooled" else ""
+            cells.append(Cell(f"{cell.n} ({cell.n_layouts}){pooled}", cell.n))
         rows.append(tuple(cells))
     caption = (f"{table.title}: SSR, CC (per step, CC / T) and SASR of each policy; n episodes "
                "per cell (and the distinct layouts among them, which the intervals count); "
                "best of each row in bold.")
+    protocols = {c.protocol for row in table.rows for c in row.cells.values() if c is not None}
+    if protocols - {None}:
+        caption += (" One dimension at a time (Fig. 4): each cell holds the episodes whose "
+                    "other two dimensions are at L0/W0/V0 (the cells fsvla run --sweep plans)"
+                    + ("; * marks a cell pooled over the other two dimensions, where the run "
+                       "has no such episodes" if "pooled" in protocols else "") + ".")
     if table.by == "category":
         caption += (" An episode counts toward its Safe-Core category and toward the Safe-Lang"
                     " (W3–W4) and Safe-Vis (V1–V4) categories of its levels, so n may sum to"
@@ -177,6 +184,9 @@ def protocol_view(protocol: Protocol) -> TextTable:
         ("Structure levels (L)", lambda p: _join(p.levels)),
         ("Language levels (W)", lambda p: _join(p.languages)),
         ("Vision levels (V)", lambda p: _join(p.visions)),
+        ("Cells per scenario", lambda p: (
+            f"{p.cells_per_scenario}: one-axis sweeps (L at W0/V0, W at L0/V0, V at L0/W0)"
+            if p.sweep else f"{p.cells_per_scenario}: the grid L × W × V")),
         ("Episodes per cell", lambda p: str(p.episodes_per_cell)),
         ("Run seeds", lambda p: _join(p.seeds)),
         ("Layouts", lambda p: p.layout_protocol),

@@ -35,8 +35,11 @@ FIGURE_CAPTIONS = {
     "landscape": "Safety–success landscape: SSR against CC per policy; bubble area is USR; "
                  "bars are the confidence intervals; the upper left is preferable.",
     "diagnosis": "Diagnosis under variation: SSR (solid, left axis) and CC (dashed, right "
-                 "axis) against severity along L, W and V; adversarial settings (W3–W4, V4) "
-                 "shaded.",
+                 "axis) against severity along L, W and V, one dimension at a time: filled "
+                 "points come from the one-axis cells (the other two dimensions at L0/W0/V0, "
+                 "as fsvla run --sweep plans them), hollow points, where a run has no such "
+                 "cell, pool the episodes at that level over the other two dimensions; "
+                 "adversarial settings (W3–W4, V4) shaded.",
     "keyframes": "Keyframes of the dissected episode.",
     "margins": "Time-aligned per-channel margins q_k(t) of the dissected episode, with the "
                "warning band [0, ε_k) and the hard threshold q = 0.",

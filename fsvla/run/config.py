@@ -8,9 +8,10 @@ run (policy, modes, embodiment, λ, timeouts), which would mix incomparable epis
 
 from __future__ import annotations
 
+import itertools
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from fsvla.run.key import Language, Level, Vision
 
@@ -20,11 +21,14 @@ LANGUAGES: tuple[Language, ...] = ("W0", "W1", "W2", "W3", "W4")
 VISIONS: tuple[Vision, ...] = ("V0", "V1", "V2", "V3", "V4")
 #: Fields ``--extend`` may change: they add episodes, they do not alter finished ones.
 GRID_FIELDS: frozenset[str] = frozenset(
-    {"scenarios", "levels", "languages", "visions", "episodes", "seeds", "warmup"})
+    {"scenarios", "levels", "languages", "visions", "sweep", "episodes", "seeds", "warmup"})
+#: Where a one-axis sweep holds the two dimensions it does not vary.
+ORIGIN: tuple[Level, Language, Vision] = ("L0", "W0", "V0")
 
 
 class RunConfig(BaseModel):
-    """What ``fsvla run`` evaluates: one policy over scenarios × L × W × V × episodes."""
+    """What ``fsvla run`` evaluates: one policy over scenarios × cells × episodes, the cells
+    being the grid L × W × V, or with ``sweep`` its one-axis sweeps (:meth:`cells`)."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -35,8 +39,9 @@ class RunConfig(BaseModel):
     levels: tuple[Level, ...] = ("L0",)
     languages: tuple[Language, ...] = ("W0",)
     visions: tuple[Vision, ...] = ("V0",)
+    sweep: bool = False  # one dimension at a time from L0/W0/V0, not the whole grid
     episodes: int = Field(default=1, ge=1)  # per cell (scenario × L × W × V), over the seeds
-    seeds: tuple[int, ...] = Field(default=(0,), min_length=1)  # layout seeds
+    seeds: tuple[int, ...] = Field(default=(0,), min_length=1)  # run seeds
     warmup: int = Field(default=1, ge=0)  # unscored episodes per scenario at L0/W0/V0, first
     control_mode: Literal["joint_pos", "joint_delta", "joint_vel", "ee_pose",
                           "ee_delta"] = "joint_pos"
@@ -64,6 +69,25 @@ class RunConfig(BaseModel):
             raise ValueError(f"seeds must not repeat, got {list(value)}")
         return value
 
+    @model_validator(mode="after")
+    def _sweep_starts_at_the_origin(self) -> RunConfig:
+        if self.sweep and not ("L0" in self.levels and "W0" in self.languages
+                               and "V0" in self.visions):
+            raise ValueError("a sweep varies one dimension at a time from L0/W0/V0, so its "
+                             "levels must include L0, W0 and V0")
+        return self
+
+    def cells(self) -> tuple[tuple[Level, Language, Vision], ...]:
+        """The (L, W, V) cells each scenario runs: the grid levels × languages × visions, or
+        with ``sweep`` the one-axis sweeps: the levels at W0/V0, the languages at L0/V0,
+        the visions at L0/W0, the L0/W0/V0 cell once (3 + 4 + 4 = 11 for full ranges)."""
+        if not self.sweep:
+            return tuple(itertools.product(self.levels, self.languages, self.visions))
+        level, language, vision = ORIGIN
+        return (*((lvl, language, vision) for lvl in self.levels),
+                *((level, lang, vision) for lang in self.languages if lang != language),
+                *((level, language, vis) for vis in self.visions if vis != vision))
+
 
 class ConfigDifference(BaseModel):
     """One field whose stored and given values differ."""
@@ -88,5 +112,5 @@ def config_differences(stored: RunConfig, given: RunConfig) -> tuple[ConfigDiffe
         for name in RunConfig.model_fields if old[name] != new[name])
 
 
-__all__ = ["CONFIG_FORMAT_VERSION", "GRID_FIELDS", "LANGUAGES", "LEVELS", "VISIONS",
+__all__ = ["CONFIG_FORMAT_VERSION", "GRID_FIELDS", "LANGUAGES", "LEVELS", "ORIGIN", "VISIONS",
            "ConfigDifference", "RunConfig", "config_differences"]

@@ -2,7 +2,8 @@
 
 Order: every scenario's warm-up episodes come first (at L0/W0/V0, ``warmup`` flag set,
 never scored), then the scored episodes in rounds: round ``e`` holds episode ``e`` of
-every cell (scenario × L × W × V), so a run stopped early still covers every cell evenly.
+every cell (scenario × ``RunConfig.cells()``: the L × W × V grid, or its one-axis sweeps),
+so a run stopped early still covers every cell evenly.
 
 How "episodes spread over seeds" is realised, for episode index ``e`` of a cell:
 
@@ -87,9 +88,7 @@ def plan_episodes(config: RunConfig, scenarios: list[PlannedScenario]) -> list[E
     specs += [_spec(config, s, level, language, vision, e)
               for e in range(config.episodes)
               for s in scenarios
-              for level in config.levels
-              for language in config.languages
-              for vision in config.visions]
+              for level, language, vision in config.cells()]
     return specs
 
 

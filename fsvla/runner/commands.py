@@ -24,7 +24,7 @@ _CONFIG_PARAMS = {
     "control_mode": "control_mode", "obs_mode": "obs_mode", "embodiment": "embodiment",
     "sasr_lambda": "sasr_lambda", "terminate_on_violation": "terminate_on_violation",
     "policy_timeout": "policy_timeout_s", "policy_profile": "policy_profile",
-    "replan_steps": "replan_steps",
+    "replan_steps": "replan_steps", "sweep": "sweep",
 }
 #: Options whose absence leaves the value to the profile, the stored run or a default.
 _DERIVED = frozenset({"obs_mode", "control_mode", "replan_steps"})
@@ -55,10 +55,16 @@ def _fail(message: str, code: int) -> None:
 @click.option("--language", default="W0", show_default=True, help="Language levels, e.g. W0-W4.")
 @click.option("--vision", default="V0", show_default=True,
               help="Vision levels, e.g. V0-V4 (beyond V0 needs rendering: --obs-mode rgb).")
+@click.option("--sweep", is_flag=True,
+              help="One dimension at a time instead of the grid: L0-L2 at W0/V0, W0-W4 at "
+                   "L0/V0, V0-V4 at L0/W0 (11 cells a scenario). Not with --levels, "
+                   "--language or --vision.")
 @click.option("--episodes", type=click.IntRange(min=1), default=1, show_default=True,
-              help="Episodes per cell (scenario x L x W x V), spread over the seeds.")
+              help="Episodes per cell (scenario x L x W x V), each on its own layout, spread "
+                   "over the seeds.")
 @click.option("--seeds", default="1", show_default=True,
-              help="Layout seeds: a count (3: seeds 0-2) or seeds such as 0-2,7.")
+              help="Run seeds: a count (3: seeds 0-2) or seeds such as 0-2,7; each episode's "
+                   "layout is drawn from its run seed and index.")
 @click.option("--warmup", type=click.IntRange(min=0), default=1, show_default=True,
               help="Unscored warm-up episodes per scenario at L0/W0/V0, run first.")
 @click.option("--out", "out_dir", required=True, type=click.Path(path_type=Path),
@@ -152,6 +158,8 @@ def _config(ctx: click.Context, out_dir: Path, options: dict[str, Any]):  # -> R
             value = tuple(v for item in value for v in item.split(",") if v.strip())
         if value is not None or name not in _DERIVED:
             fields[field] = value
+    if options["sweep"]:
+        fields.update(_sweep_ranges(given))
     fields = profile_defaults(fields, {_CONFIG_PARAMS[name] for name in given})
     if fields.get("obs_mode") is None:
         fields["obs_mode"] = "state" if tuple(fields.get("visions", ("V0",))) == ("V0",) else "rgb"
@@ -160,6 +168,19 @@ def _config(ctx: click.Context, out_dir: Path, options: dict[str, Any]):  # -> R
             raise RunInputError(f"--{required}", f"--{required} is required to start a run "
                                 f"({out_dir} holds none to resume)")
     return make_config(**fields)
+
+
+def _sweep_ranges(given: set[str]) -> dict[str, Any]:
+    """What --sweep sets: every level of the three dimensions (which --levels, --language
+    and --vision would contradict)."""
+    from fsvla.run.config import LANGUAGES, LEVELS, VISIONS
+    from fsvla.runner import RunInputError
+
+    named = [f"--{name}" for name in ("levels", "language", "vision") if name in given]
+    if named:
+        raise RunInputError("--sweep", "--sweep runs L0-L2 at W0/V0, W0-W4 at L0/V0 and V0-V4 "
+                            f"at L0/W0; it cannot be combined with {', '.join(named)}")
+    return {"levels": LEVELS, "languages": LANGUAGES, "visions": VISIONS}
 
 
 def _check_ray() -> None:

@@ -24,7 +24,7 @@ OPTIONS: dict[str, str] = {
     "seeds": "--seeds", "warmup": "--warmup", "control_mode": "--control-mode",
     "obs_mode": "--obs-mode", "embodiment": "--embodiment", "sasr_lambda": "--sasr-lambda",
     "terminate_on_violation": "--terminate-on-violation", "policy_timeout_s": "--policy-timeout",
-    "policy_profile": "--policy-profile", "replan_steps": "--replan-steps",
+    "policy_profile": "--policy-profile", "replan_steps": "--replan-steps", "sweep": "--sweep",
 }
 
 

@@ -109,3 +109,39 @@ def test_ray_backend_without_ray_is_a_usage_error(scenario: Path, tmp_path: Path
     assert run(argv) == 2
     assert "--backend ray needs the ray package" in capsys.readouterr().err
     assert not (tmp_path / "ray").exists()
+
+
+def test_sweep_plans_eleven_cells_a_scenario(scenario: Path, tmp_path: Path, monkeypatch,
+                                             capsys) -> None:
+    import fsvla.runner
+
+    planned = {}
+
+    def capture(prepared, *args, **kwargs):
+        planned["config"], planned["plan"] = prepared.config, prepared.plan
+        raise fsvla.runner.RunInputError("--sweep", "stop: the plan is all this test needs")
+
+    monkeypatch.setattr(fsvla.runner, "execute_run", capture)
+    argv = ["run", "--policy", "hold-still", "--scenarios", str(scenario), "--sweep",
+            "--episodes", "2", "--warmup", "0", "--workers", "0", "--out", str(tmp_path / "s")]
+    assert run(argv) == 2 and "stop: the plan" in capsys.readouterr().err
+    config, plan = planned["config"], planned["plan"]
+    assert config.sweep and config.obs_mode == "rgb"  # V1-V4 are in the sweep
+    cells = {(s.key.level, s.key.language, s.key.vision) for s in plan}
+    assert len(cells) == 11 and len(plan) == 22
+    assert {c for c in cells if c[1:] == ("W0", "V0")} == {("L0", "W0", "V0"), ("L1", "W0", "V0"),
+                                                        ("L2", "W0", "V0")}
+
+
+@pytest.mark.parametrize("option", [["--levels", "L0-L1"], ["--language", "W0"],
+                                    ["--vision", "V0-V4"]])
+def test_sweep_with_explicit_levels_is_a_usage_error(scenario: Path, tmp_path: Path, capsys,
+                                                     option: list[str]) -> None:
+    out = tmp_path / "never"
+    argv = ["run", "--policy", "hold-still", "--scenarios", str(scenario), "--sweep", *option,
+            "--workers", "0", "--out", str(out)]
+    assert run(argv) == 2
+    err = capsys.readouterr().err
+    assert (f"--sweep runs L0-L2 at W0/V0, W0-W4 at L0/V0 and V0-V4 at L0/W0; it cannot be "
+            f"combined with {option[0]}") in " ".join(err.split())
+    assert "Traceback" not in err and not out.exists()

@@ -9,6 +9,7 @@ import pytest
 from fsvla.metrics import CC_NORMALISATION
 from fsvla.report import load_runs
 from fsvla.report.data import NothingToReport, ReportInputError
+from fsvla.report.tables import group_table
 from fsvla.results import ResultStore
 
 from .conftest import EPISODES_B, POLICY_A, POLICY_B, VERSIONS, make_run
@@ -86,12 +87,23 @@ def test_per_category_and_embodiment(report_data) -> None:
 
 
 def test_severity_series(report_data) -> None:
-    _, report = report_data
+    # Fig. 4 points come from the one-axis cells (the other two dimensions at L0/W0/V0),
+    # which the fixtures' grid holds: W0 and W3 at V0, V0 and V4 at W0.
+    runs, report = report_data
     language = {r.key: r.cells[POLICY_A] for r in report.severity["language"].rows}
     assert list(language) == ["W0", "W3"]
-    assert language["W0"].ssr.estimate == 0.75 and language["W0"].cc.estimate == approx(0.0625)
-    assert language["W3"].ssr.estimate == 0 and language["W3"].cc.estimate == approx(0.5625)
+    assert {c.protocol for c in language.values()} == {"sweep"}
+    assert (language["W0"].n, language["W0"].ssr.estimate, language["W0"].cc.estimate) == (
+        2, 1.0, 0.0)
+    assert (language["W3"].n, language["W3"].ssr.estimate) == (2, 0.0)
+    assert language["W3"].cc.estimate == approx(0.5)  # the stove's violation: CC/T 1; edge: 0
+    vision = {r.key: r.cells[POLICY_A] for r in report.severity["vision"].rows}
+    assert vision["V4"].ssr.estimate == 0.5 and vision["V4"].cc.estimate == approx(0.125)
     assert [r.key for r in report.severity["level"].rows] == ["L0"]
+    # the pooled breakdown, over the other two dimensions, is still a group table
+    pooled = {r.key: r.cells[POLICY_A] for r in group_table(runs, "language").rows}
+    assert pooled["W0"].ssr.estimate == 0.75 and pooled["W0"].cc.estimate == approx(0.0625)
+    assert pooled["W3"].ssr.estimate == 0 and pooled["W3"].cc.estimate == approx(0.5625)
 
 
 def test_derived_statements(report_data) -> None:
