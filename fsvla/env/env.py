@@ -14,13 +14,16 @@ The benchmark coordinates are fixed at construction: the layout by ``level`` and
 ``seed`` (L0–L2), the instruction by ``language`` (W0–W4) and the pictures by ``vision``
 (V0–V4), both drawn with the same ``seed`` (``fsvla.variation``) unless ``language_seed`` /
 ``vision_seed`` are given; ``vary()`` changes W and V for the next episodes. Vision levels change
-only rendered observations, so they need ``obs_mode="rgb"``. ``reset(seed=...)`` seeds nothing else (the simulation is deterministic);
+only rendered observations, so they need ``obs_mode="rgb"``. ``cameras``, ``resolution`` and
+``shader`` choose what is rendered; an observation's pictures are rendered when they are
+first read (:mod:`fsvla.env.frames`), not at every step. ``reset(seed=...)`` seeds nothing else (the simulation is deterministic);
 a reset after an episode rebuilds the SAPIEN scene, whose contact caches no state reset
 clears, so the same seed and actions give the identical trace in any episode.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
@@ -28,7 +31,7 @@ import gymnasium
 import numpy as np
 
 from fsvla.compiler.monitor import MonitorSpec, lower_monitor
-from fsvla.compiler.scene import Level, SceneSpec
+from fsvla.compiler.scene import Level, SceneCamera, SceneSpec
 from fsvla.compiler.variants import generate_variant
 from fsvla.dsl.models import Scenario
 from fsvla.embodiments import load_embodiment
@@ -36,13 +39,16 @@ from fsvla.library import ScenarioRef, load_scenario
 from fsvla.monitor import SafetyMonitor
 from fsvla.monitor.start import start_error
 from fsvla.sim.builder import BuiltScene, build
+from fsvla.sim.cameras import camera_selection, parse_resolution
 from fsvla.sim.kinematics import ArmKinematics
+from fsvla.sim.render import DEFAULT_SHADER, check_shader
 from fsvla.sim.robot import LoadedArm
 from fsvla.variation.apply import VisionApplier
 from fsvla.variation.language import Instruction, instruction_for
 from fsvla.variation.vision import VisionPerturbation, perturbation_for
 
 from .actions import ActionCodec, ArmCommand, ArmLayout, ControlMode, joint_targets, tcp_target
+from .frames import LazyImages, StaleFrameError
 from .observations import assemble, check_instruction, observation_space, proprioception
 from .recording import EpisodeRecorder
 
@@ -63,6 +69,9 @@ class EnvConfig:
     control_mode: str
     terminate_on_violation: bool
     monitor: bool
+    cameras: tuple[str, ...] = ()  # the cameras rendered (rgb observations, render())
+    resolution: tuple[int, int] | None = None  # (width, height) of each; None: the spec's
+    shader: str = DEFAULT_SHADER
 
 
 class FsvlaEnv(gymnasium.Env):
@@ -90,6 +99,10 @@ class FsvlaEnv(gymnasium.Env):
         render_mode: str | None = None,
         language_seed: int | None = None,
         vision_seed: int | None = None,
+        cameras: Sequence[str] | None = None,
+        resolution: tuple[int, int] | str | None = None,
+        shader: str = DEFAULT_SHADER,
+        lazy_images: bool = True,
     ) -> None:
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode must be one of {', '.join(OBS_MODES)}, got {obs_mode!r}")
@@ -102,11 +115,22 @@ class FsvlaEnv(gymnasium.Env):
         self.scenario: Scenario = variant.scenario
         self.scene_spec: SceneSpec = variant.scene
         self.monitor_spec: MonitorSpec = lower_monitor(variant.scenario, variant.scene)
+        size = parse_resolution(resolution) if resolution is not None else None
+        #: The scene as rendered: the layout's, with the chosen cameras at their resolution.
+        self.render_spec: SceneSpec = self.scene_spec.model_copy(update={
+            "cameras": camera_selection(self.scene_spec.cameras, cameras, size)})
         self.config = EnvConfig(
             scenario=source.name, level=level, seed=seed, language=language, vision=vision,
             embodiment=self.scene_spec.embodiment.name, obs_mode=obs_mode,
             control_mode=ControlMode(control_mode).value,
-            terminate_on_violation=terminate_on_violation, monitor=monitor)
+            terminate_on_violation=terminate_on_violation, monitor=monitor,
+            cameras=tuple(c.name for c in self.render_spec.cameras), resolution=size,
+            shader=check_shader(shader))
+        self._lazy_images = lazy_images
+        self._epoch = 0  # counts steps and resets: which scene state a picture shows
+        self._frame: tuple[int, dict[str, np.ndarray]] | None = None  # (epoch, raw views)
+        #: Render passes so far (each renders every camera once): the cost of the pictures.
+        self.frames_rendered = 0
         self._source = source
         wants_images = obs_mode == "rgb" or render_mode == "rgb_array"
         if vision != "V0" and not wants_images:
@@ -125,7 +149,7 @@ class FsvlaEnv(gymnasium.Env):
         self.observation_space = observation_space(
             [v for layout in layouts for v in _finite(layout.lower, -np.pi)],
             [v for layout in layouts for v in _finite(layout.upper, np.pi)],
-            len(arms), self.scene_spec.cameras, with_images=obs_mode == "rgb")
+            len(arms), self.cameras, with_images=obs_mode == "rgb")
         physics = self.scene_spec.physics
         self.substeps = physics.substeps
         self.control_dt = physics.control_dt
@@ -149,12 +173,14 @@ class FsvlaEnv(gymnasium.Env):
             self._check_start()
         self.recorder.start()
         self._t = 0
+        self._epoch += 1
         info = {"step": 0, "max_steps": self.max_steps, "instruction": self.instruction}
         return self._observe(), info
 
     def step(self, action: Any):
         commands = self.codec.decode(action)
         self._stepped = True
+        self._epoch += 1  # the pictures of the last observation can no longer be rendered
         ik_errors = self._apply(commands)
         monitor = self.monitor
         ramps, substep_dt = self._ramps, self.control_dt / self.substeps
@@ -182,7 +208,7 @@ class FsvlaEnv(gymnasium.Env):
     def render(self):
         if self.render_mode != "rgb_array":
             return None
-        views = self.built.render_views()
+        views = self._views()
         return np.concatenate(list(views.values()), axis=1) if views else None
 
     def close(self) -> None:
@@ -207,6 +233,12 @@ class FsvlaEnv(gymnasium.Env):
             self._vision.apply(self.vision)
         self.config = replace(self.config, language=language, vision=vision)
 
+    @property
+    def cameras(self) -> tuple[SceneCamera, ...]:
+        """The cameras rendered, as built (name, mount, resolution); empty without
+        rendering."""
+        return tuple(c for c in self.render_spec.cameras if c.name in self.built.cameras)
+
     # -------------------------------------------------------------- traces
     def episode_record(self):
         """The episode so far: per-step margins, costs, states, actions (see recording)."""
@@ -215,9 +247,9 @@ class FsvlaEnv(gymnasium.Env):
     # -------------------------------------------------------------- internals
     def _build_scene(self) -> None:
         """A fresh SAPIEN scene of the layout, with its monitor and visual variation."""
-        self.built = build(self.scene_spec, render=self._render)
+        self.built = build(self.render_spec, render=self._render, shader=self.config.shader)
         self.monitor = SafetyMonitor(self.monitor_spec, self.built) if self.config.monitor else None
-        self._vision = (VisionApplier(self.built.appearance(), self.scene_spec)
+        self._vision = (VisionApplier(self.built.appearance(), self.render_spec)
                         if self.built.renders else None)
         self._stepped = False
 
@@ -262,10 +294,29 @@ class FsvlaEnv(gymnasium.Env):
     def _observe(self) -> dict[str, Any]:
         images = None
         if self.config.obs_mode == "rgb":
-            images = self.built.render_views()
-            if self._vision is not None:
-                images = self._vision.composite(images)
+            epoch = self._epoch
+            images = LazyImages(self.built.cameras, lambda: self._pictures(epoch))
+            if not self._lazy_images:
+                images = images.copy()
         return assemble(proprioception(self.built.robot), self.instruction, images)
+
+    def _pictures(self, epoch: int) -> dict[str, np.ndarray]:
+        """The observation pictures of ``epoch`` (the V4 patches pasted in), while the
+        scene is still there."""
+        if epoch != self._epoch:
+            raise StaleFrameError(
+                "the images of this observation were not read before the environment "
+                "stepped or reset, and can no longer be rendered: read obs['images'] before "
+                "the next step, or make the environment with lazy_images=False")
+        views = self._views()
+        return self._vision.composite(views) if self._vision is not None else views
+
+    def _views(self) -> dict[str, np.ndarray]:
+        """Every camera's picture of the scene now, rendered once per step."""
+        if self._frame is None or self._frame[0] != self._epoch:
+            self._frame = (self._epoch, self.built.render_views())
+            self.frames_rendered += 1
+        return self._frame[1]
 
 
 def _finite(values: tuple[float, ...], bound: float) -> list[float]:

@@ -9,7 +9,8 @@ An observation is a dict:
   ``[x, y, z, qw, qx, qy, qz]`` (quaternion scalar first), concatenated per arm.
 - ``"instruction"``: the task instruction as a string.
 - ``"images"`` (``obs_mode="rgb"`` only): one ``H × W × 3`` ``uint8`` RGB array per camera,
-  keyed by camera name (the head/front view and one per wrist).
+  keyed by camera name (the head/front view and one per wrist); a
+  :class:`~fsvla.env.frames.LazyImages` that renders them when they are first read.
 """
 
 from __future__ import annotations
@@ -89,8 +90,8 @@ def proprioception(robot: LoadedRobot) -> dict[str, np.ndarray]:
 def assemble(agent: Mapping[str, np.ndarray], instruction: str,
              images: Mapping[str, np.ndarray] | None) -> dict[str, Any]:
     obs: dict[str, Any] = {"agent": dict(agent), "instruction": instruction}
-    if images is not None:
-        obs["images"] = dict(images)
+    if images is not None:  # a dict (LazyImages: rendered when read) is kept as it is
+        obs["images"] = images if isinstance(images, dict) else dict(images)
     return obs
 
 

@@ -6,6 +6,8 @@ the observation/action schema), then asks ``act(observation)`` for an action ``(
 a chunk ``(H, A)`` and executes the chunk itself, one control step per row (its first
 ``replan_steps`` rows, when given, as openpi's clients do), asking again when they are
 used up, so the monitor sees every action and every physics substep.
+Pictures are rendered only for the observations the policy is asked about (or that
+``on_frame`` reads): the environment renders ``obs["images"]`` when it is first read.
 
 Anything that goes wrong ends the episode with a :class:`Fault` naming the failure
 reason (``fsvla.results.FailureReason``): the policy raised (``policy_error``), returned
@@ -69,7 +71,7 @@ def episode_info(env: FsvlaEnv, spec: EpisodeSpec) -> EpisodeInfo:
     cameras = ()
     if env.config.obs_mode == "rgb":
         cameras = tuple(CameraSchema(name=c.name, height=c.height, width=c.width, mount=c.parent)
-                        for c in env.scene_spec.cameras if c.name in env.built.cameras)
+                        for c in env.cameras)
     key = spec.key
     if env.config.embodiment != key.embodiment:  # the one that runs
         key = key.model_copy(update={"embodiment": env.config.embodiment})
