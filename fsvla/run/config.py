@@ -51,6 +51,9 @@ class RunConfig(BaseModel):
     terminate_on_violation: bool = False
     policy_timeout_s: float | None = Field(default=None, gt=0, allow_inf_nan=False)  # per act()
     replan_steps: int | None = Field(default=None, ge=1)  # actions of a chunk run; None: all
+    cameras: tuple[str, ...] | None = None  # the cameras rendered; None: all of the embodiment's
+    resolution: tuple[int, int] | None = None  # (width, height) of each; None: the cameras' own
+    shader: Literal["minimal", "default", "rt"] = "minimal"  # the cameras' shader
 
     @field_validator("levels", "languages", "visions")
     @classmethod
@@ -58,6 +61,20 @@ class RunConfig(BaseModel):
         if not value:
             raise ValueError("name at least one level")
         return tuple(sorted(set(value)))
+
+    @field_validator("cameras")
+    @classmethod
+    def _cameras_named(cls, value: tuple[str, ...] | None) -> tuple[str, ...] | None:
+        if value is not None and (not value or not all(name.strip() for name in value)):
+            raise ValueError("name at least one camera, and no empty names")
+        return value
+
+    @field_validator("resolution")
+    @classmethod
+    def _resolution_positive(cls, value: tuple[int, int] | None) -> tuple[int, int] | None:
+        if value is not None and not all(1 <= side <= 4096 for side in value):
+            raise ValueError(f"a resolution is 1 to 4096 pixels a side, got {value[0]}x{value[1]}")
+        return value
 
     @field_validator("seeds")
     @classmethod

@@ -25,6 +25,7 @@ _CONFIG_PARAMS = {
     "sasr_lambda": "sasr_lambda", "terminate_on_violation": "terminate_on_violation",
     "policy_timeout": "policy_timeout_s", "policy_profile": "policy_profile",
     "replan_steps": "replan_steps", "sweep": "sweep",
+    "cameras": "cameras", "resolution": "resolution", "shader": "shader",
 }
 #: Options whose absence leaves the value to the profile, the stored run or a default.
 _DERIVED = frozenset({"obs_mode", "control_mode", "replan_steps"})
@@ -83,6 +84,15 @@ def _fail(message: str, code: int) -> None:
               type=click.Choice(["joint_pos", "joint_delta", "joint_vel", "ee_pose", "ee_delta"]),
               help="The action format. Default: the profile's, else joint_pos.")
 @click.option("--embodiment", default=None, help="Run every scenario on this embodiment.")
+@click.option("--cameras", default=None, metavar="NAMES",
+              help="The cameras rendered, comma-separated, e.g. front,wrist. Default: all of "
+                   "the embodiment's.")
+@click.option("--resolution", default=None, metavar="WIDTHxHEIGHT",
+              help="Every rendered camera's resolution, e.g. 160x120. Default: each camera's "
+                   "own (320x240 for the built-in embodiments).")
+@click.option("--shader", type=click.Choice(["minimal", "default", "rt"]), default="minimal",
+              show_default=True, help="The cameras' shader: minimal (fast), default (lit, "
+              "shadows) or rt (ray traced).")
 @click.option("--sasr-lambda", type=float, default=1.0, show_default=True, help="SASR's lambda.")
 @click.option("--terminate-on-violation", is_flag=True,
               help="End an episode at its first hard violation.")
@@ -145,7 +155,7 @@ def _config(ctx: click.Context, out_dir: Path, options: dict[str, Any]):  # -> R
         raise RunInputError("--out", str(problem)) from None
     fields: dict[str, Any] = stored.model_dump() if stored is not None else {}
     parsers = {"levels": parse_levels, "language": parse_languages, "vision": parse_visions,
-               "seeds": parse_seeds}
+               "seeds": parse_seeds, "cameras": _parse_cameras, "resolution": _parse_resolution}
     for name, field in _CONFIG_PARAMS.items():
         if stored is not None and name not in given:
             continue
@@ -181,6 +191,27 @@ def _sweep_ranges(given: set[str]) -> dict[str, Any]:
         raise RunInputError("--sweep", "--sweep runs L0-L2 at W0/V0, W0-W4 at L0/V0 and V0-V4 "
                             f"at L0/W0; it cannot be combined with {', '.join(named)}")
     return {"levels": LEVELS, "languages": LANGUAGES, "visions": VISIONS}
+
+
+def _parse_cameras(text: str | None) -> tuple[str, ...] | None:
+    from fsvla.runner import RunInputError
+
+    if text is None:
+        return None
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    if not names:
+        raise RunInputError("--cameras", "name at least one camera, e.g. --cameras front")
+    return names
+
+
+def _parse_resolution(text: str | None) -> tuple[int, int] | None:
+    from fsvla.runner import RunInputError
+    from fsvla.sim.cameras import parse_resolution
+
+    try:
+        return None if text is None else parse_resolution(text)
+    except ValueError as err:
+        raise RunInputError("--resolution", str(err)) from None
 
 
 def _check_ray() -> None:

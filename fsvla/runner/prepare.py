@@ -23,6 +23,7 @@ OPTIONS: dict[str, str] = {
     "languages": "--language", "visions": "--vision", "episodes": "--episodes",
     "seeds": "--seeds", "warmup": "--warmup", "control_mode": "--control-mode",
     "obs_mode": "--obs-mode", "embodiment": "--embodiment", "sasr_lambda": "--sasr-lambda",
+    "cameras": "--cameras", "resolution": "--resolution", "shader": "--shader",
     "terminate_on_violation": "--terminate-on-violation", "policy_timeout_s": "--policy-timeout",
     "policy_profile": "--policy-profile", "replan_steps": "--replan-steps", "sweep": "--sweep",
 }
@@ -155,7 +156,24 @@ def prepare_run(config: RunConfig) -> PreparedRun:
         plan = plan_episodes(config, scenarios)
     except ValueError as err:
         raise RunInputError("--scenarios", str(err)) from None
+    if config.cameras is not None:
+        check_cameras(config.cameras, config.embodiment, scenarios)
     return PreparedRun(config=config, scenarios=tuple(scenarios), plan=tuple(plan))
+
+
+def check_cameras(cameras: Sequence[str], embodiment: str | None,
+                  scenarios: Sequence[PlannedScenario]) -> None:
+    """Every camera ``--cameras`` names must be one of each scenario's embodiment
+    (``embodiment`` when it overrides theirs)."""
+    from fsvla.embodiments import load_embodiment
+    from fsvla.sim.cameras import check_camera_names
+
+    for name in dict.fromkeys(embodiment or s.embodiment for s in scenarios):
+        known = [c.name for c in load_embodiment(name).cameras]
+        try:
+            check_camera_names(cameras, known)
+        except ValueError as err:
+            raise RunInputError("--cameras", f"embodiment {name}: {err}") from None
 
 
 def check_run_folder(out: Path, config: RunConfig, *, extend: bool = False) -> bool:

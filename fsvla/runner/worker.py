@@ -56,6 +56,7 @@ def make_env(spec: EpisodeSpec, config: RunConfig, *, render: bool = False,
                 obs_mode=config.obs_mode, control_mode=config.control_mode,
                 language=key.language, vision=key.vision, language_seed=spec.language_seed,
                 vision_seed=spec.vision_seed, terminate_on_violation=config.terminate_on_violation,
+                cameras=config.cameras, resolution=config.resolution, shader=config.shader,
                 render_mode="rgb_array" if render else None)
 
 

@@ -63,6 +63,11 @@ def test_run_resume_and_replay(scenario: Path, tmp_path: Path, capsys) -> None:
     (["--embodiment", "pandaa"], "--embodiment: unknown embodiment `pandaa`"),
     (["--sasr-lambda", "-1"], "--sasr-lambda: Input should be greater than or equal to 0"),
     (["--policy-timeout", "0"], "--policy-timeout: Input should be greater than 0"),
+    (["--cameras", "frnt"], "unknown camera 'frnt'; did you mean 'front'?"),
+    (["--cameras", ","], "--cameras: name at least one camera"),
+    (["--resolution", "160by120"], "--resolution: resolution must be WIDTHxHEIGHT"),
+    (["--resolution", "0x120"], "--resolution: resolution 0x120 is outside 1..4096"),
+    (["--shader", "fancy"], "Invalid value for '--shader'"),
 ])
 def test_bad_input_names_the_option_and_writes_nothing(scenario: Path, tmp_path: Path, capsys,
                                                        args: list[str], says: str) -> None:
@@ -77,6 +82,23 @@ def test_bad_input_names_the_option_and_writes_nothing(scenario: Path, tmp_path:
     err = capsys.readouterr().err
     assert says in err and "Traceback" not in err
     assert not out.exists()
+
+
+def test_the_cameras_of_a_run_are_stored_and_resumed(scenario: Path, tmp_path: Path,
+                                                       capsys) -> None:
+    from fsvla.results import ResultStore
+
+    out = tmp_path / "cams"
+    assert run(["run", "--policy", "hold-still", "--scenarios", str(scenario), "--warmup", "0",
+                "--workers", "0", "--out", str(out), "--cameras", "front",
+                "--resolution", "160x120", "--shader", "default"]) == 0
+    with ResultStore.open(out, readonly=True) as store:
+        stored = store.config
+    assert (stored.cameras, stored.resolution, stored.shader) == (("front",), (160, 120), "default")
+    assert run(["run", "--out", str(out), "--workers", "0"]) == 0  # resumes with them
+    assert "1 already recorded" in capsys.readouterr().out
+    assert run(["run", "--out", str(out), "--workers", "0", "--resolution", "320x240"]) == 2
+    assert "resolution: [160, 120] in the run folder, [320, 240] now" in capsys.readouterr().err
 
 
 def test_a_run_folder_holding_another_run_is_refused(scenario: Path, tmp_path: Path,
