@@ -7,16 +7,26 @@ i.e. importing SAPIEN and loading the policy, is shown apart); every episode bui
 own scene, runs its monitor on every substep, and is recorded (SQLite row + Parquet
 trace) by the main process, exactly as in a run. Warm-ups are off.
 
+It first measures rendering what is looked at (issue 21): one careful-expert episode
+(10-step chunks) of ``--bar-scenario``, state-only and with rgb observations whose every
+picture the policy reads at each query (as a VLA does), in one process; the bar is rgb
+<= 4x state-only. The same episode rendered at every step (``lazy_images=False``) must
+give the identical episode record and final state.
+
     python bench/run.py [--policy careful-expert] [--scenario lift_pot_beside_stove]
                         [--episodes 16] [--rgb-episodes 8] [--workers 1,2] [--no-render]
+                        [--bar-scenario stack_block_gently] [--bar-repeats 3] [--no-bar]
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
 import multiprocessing
 import os
 import resource
+import statistics
 import tempfile
 import time
 from pathlib import Path
@@ -25,6 +35,8 @@ from fsvla.results import ResultStore
 from fsvla.runner import execute_run, make_backend, make_config, prepare_run
 
 TARGET_SPEEDUP = 1.7
+#: Rendering what is looked at: an rgb episode at most this many times a state-only one.
+TARGET_RGB_RATIO = 4.0
 
 
 def cpu_seconds(who: int) -> float:
@@ -51,6 +63,68 @@ def measure(policy: str, scenario: str, episodes: int, workers: int,
             "worker_cpu": (cpu_seconds(resource.RUSAGE_CHILDREN) - children) / episodes,
             "main_cpu": (cpu_seconds(resource.RUSAGE_SELF) - main) / episodes,
             "load": os.getloadavg()[0]}
+
+
+def looked_at_episode(scenario: str, obs_mode: str, lazy: bool = True) -> dict[str, object]:
+    """One careful-expert episode, made, reset and run to its end in this process; the
+    expert reads every picture of each observation it is asked about. Its wall time,
+    steps, policy queries, render passes, and a digest of its record and final state."""
+    from fsvla.env import make
+    from fsvla.experts.policy import make_expert
+
+    clock = time.perf_counter()
+    env = make(scenario, obs_mode=obs_mode, lazy_images=lazy)
+    expert = make_expert(env, "careful")
+    obs, _ = env.reset()
+    expert.reset(None)
+    steps = queries = 0
+    done = False
+    while not done:
+        pictures = [image.shape for image in obs.get("images", {}).values()]  # looks
+        queries += bool(pictures) or obs_mode == "state"
+        for action in expert.act(obs):
+            obs, _, terminated, truncated, _ = env.step(action)
+            steps += 1
+            done = terminated or truncated
+            if done:
+                break
+    seconds = time.perf_counter() - clock
+    record = json.dumps(env.episode_record().to_dict(), sort_keys=True, default=str).encode()
+    digest = hashlib.sha256(record + env.built.state().tobytes()).hexdigest()[:16]
+    return {"seconds": seconds, "steps": steps, "queries": queries,
+            "frames": env.frames_rendered, "digest": digest}
+
+
+def rendering_bar(scenario: str, repeats: int) -> None:
+    """State-only and rgb (lazy) careful-expert episodes, the median of ``repeats`` each,
+    interleaved; one rgb episode rendered at every step for the outcome check."""
+    from fsvla.env import make
+
+    warm = make(scenario, obs_mode="rgb")  # shader compilation (seconds, once a process)
+    warm.reset()[0]["images"].copy()
+    runs: dict[str, list[dict[str, object]]] = {"state": [], "rgb": []}
+    for _ in range(repeats):
+        runs["state"].append(looked_at_episode(scenario, "state"))
+        runs["rgb"].append(looked_at_episode(scenario, "rgb"))
+    runs["rgb, every step"] = [looked_at_episode(scenario, "rgb", lazy=False)]
+    print(f"render what is looked at: careful expert (10-step chunks) on {scenario}, "
+          f"{repeats} episode(s) a mode, median")
+    print(f"{'mode':16} {'episode s':>9} {'steps':>6} {'queries':>8} {'frames':>7}  digest")
+    median = {}
+    for mode, episodes in runs.items():
+        median[mode] = statistics.median(float(e["seconds"]) for e in episodes)  # type: ignore[arg-type]
+        e = episodes[0]
+        print(f"{mode:16} {median[mode]:>9.2f} {e['steps']:>6} {e['queries']:>8} "
+              f"{e['frames']:>7}  {e['digest']}", flush=True)
+    ratio = median["rgb"] / median["state"]
+    digests = {str(e["digest"]) for episodes in runs.values() for e in episodes}
+    print(f"rgb / state-only = {ratio:.2f}x (bar: <= {TARGET_RGB_RATIO:.0f}x: "
+          f"{'met' if ratio <= TARGET_RGB_RATIO else 'MISSED'}); rendering every step "
+          f"{median['rgb, every step'] / median['state']:.1f}x; outcomes "
+          f"{'identical' if len(digests) == 1 else 'DIFFER'} in every mode "
+          "(record and final state digests)\n", flush=True)
+    if len(digests) != 1:
+        raise SystemExit("rendering changed an episode's outcome")
 
 
 def _spin(iterations: int) -> float:
@@ -83,6 +157,13 @@ def main() -> None:
                         help="rendering episodes per run (each worker compiles its shaders at its first: ~3 s)")
     parser.add_argument("--workers", default="1,2", help="worker counts, comma-separated")
     parser.add_argument("--no-render", action="store_true", help="skip the rendering runs")
+    parser.add_argument("--bar-scenario", default="stack_block_gently",
+                        help="the scenario of the rendering bar (rgb vs state-only episode)")
+    parser.add_argument("--bar-repeats", type=int, default=3,
+                        help="episodes per mode of the rendering bar (median)")
+    parser.add_argument("--no-bar", action="store_true", help="skip the rendering bar")
+    parser.add_argument("--no-throughput", action="store_true",
+                        help="skip the worker throughput runs")
     args = parser.parse_args()
     counts = [int(w) for w in args.workers.split(",")]
     modes = [("state", args.episodes)]
@@ -91,8 +172,12 @@ def main() -> None:
 
         if render_available():
             modes.append(("rgb", args.rgb_episodes))
+            if not args.no_bar:
+                rendering_bar(args.bar_scenario, args.bar_repeats)
         else:
             print("no Vulkan device: rendering runs skipped")
+    if args.no_throughput:
+        return
     print(f"policy {args.policy}, scenario {args.scenario}; {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.1f}; a plain CPU loop gets "
           f"{machine_ceiling():.2f}x from 2 processes right now")
