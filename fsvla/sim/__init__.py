@@ -1,4 +1,5 @@
-"""The SAPIEN back-end of the fsvla runtime.
+"""The SAPIEN back-end of the fsvla runtime: it implements the protocols of ``fsvla.world``
+through which the monitor, the experts and the visual variation read and change a scene.
 
 Importing this package does not import SAPIEN; the modules that need it import it
 inside their functions, so ``fsvla check`` and spec-only code stay cheap.
@@ -6,7 +7,11 @@ inside their functions, so ``fsvla check`` and spec-only code stay cheap.
 - :func:`build` (in ``fsvla.sim.builder``): a SceneSpec to a SAPIEN scene, a :class:`BuiltScene`.
 - ``fsvla.sim.render``: the Vulkan device, cameras, lights (:class:`RenderUnavailable`).
 - ``fsvla.sim.overlays`` and ``fsvla.sim.preview``: safety overlays, ``fsvla preview``.
-- ``fsvla.sim.robot``: embodiments as PD-driven articulations (:func:`load_robot`).
+- ``fsvla.sim.robot``: embodiments as PD-driven articulations (:func:`load_robot`);
+  ``fsvla.sim.kinematics``: an arm's FK and IK (``fsvla.world.ArmModel``).
+- ``fsvla.sim.probe``: the monitor's reader of contacts, poses and joints
+  (``fsvla.world.StepProbe``); ``fsvla.sim.appearance``: a rendering scene's look, for
+  the visual variation (``fsvla.world.SceneAppearance``).
 """
 
 from __future__ import annotations
