@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from fsvla.library import builtin_scenarios, load_scenario
 from fsvla.variation.vision import LEVELS, perturbation_for
 
@@ -60,6 +61,7 @@ def test_unknown_level_is_refused(stove) -> None:
 @pytest.mark.render
 def test_v4_changes_pictures_but_not_physics(stove, render_device) -> None:
     from fsvla.compiler.scene import lower_scene
+
     from fsvla.sim.builder import build
     from fsvla.variation.apply import VisionApplier
 
@@ -85,6 +87,7 @@ def test_v4_changes_pictures_but_not_physics(stove, render_device) -> None:
 @pytest.mark.render
 def test_restore_returns_to_v0(stove, render_device) -> None:
     from fsvla.compiler.scene import lower_scene
+
     from fsvla.sim.builder import build
     from fsvla.variation.apply import VisionApplier
 
