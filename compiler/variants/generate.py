@@ -1,11 +1,12 @@
 """``generate_variant``: a seeded, feasibility-checked layout of a scenario at L0, L1 or L2.
 
 L0 is the canonical layout with a small nuisance jitter: the scenario's ``L0`` jitters when
-it writes them (none for ``L0: none``), else every task object jittered by
+it writes them (none for ``L0: none``), else every rigid task object jittered by
 ``NUISANCE_DISTANCE`` and ``NUISANCE_YAW``. L1 applies the scenario's ``L1`` rules; L2
-applies the L1 rules and then the ``L2`` rules (cumulative; the L0 nuisance is L0's own). Each sample draws every rule in order —
-jitters, approaches and clutter move or add things; tightens and couples change the
-limits and requirements — and is accepted when it passes every check of
+applies the L1 rules and then the ``L2`` rules (cumulative; the L0 nuisance is L0's own).
+Each sample draws every rule in order — jitters, approaches and clutter move or add
+things; tightens and couples change the limits and requirements — and is accepted when
+it passes every check of
 :mod:`.feasibility`. Static checks run first and fail without sampling. The random
 generator is seeded from SHA-256 of (source digest, "L", level, seed), so a layout is
 the same on every machine.
@@ -124,14 +125,21 @@ def _freeze(params: Mapping[str, ParamValue]) -> tuple | None:
 
 def nuisance_rules(scenario: Scenario) -> tuple[VariantRule, ...]:
     """L0's nuisance jitter: the scenario's ``L0`` rules when it writes them (``L0: none``
-    gives none), else each task object within ``NUISANCE_DISTANCE`` and ``NUISANCE_YAW``,
-    on the line of its ``task``."""
+    gives none), else each rigid task object (not the articulated furniture, a cabinet or
+    a lidded box, which is the scene the task is done in) within ``NUISANCE_DISTANCE`` and
+    ``NUISANCE_YAW``, on the line of its ``task``."""
     if "L0" in scenario.variants:
         return scenario.variants["L0"]
     objects = [name for name in dict.fromkeys(scenario.task.roles.values())
-               if name != "table" and scenario.object(name) is not None]
+               if name != "table" and _rigid(scenario, name)]
     return tuple(Jitter(target=name, distance=NUISANCE_DISTANCE, yaw=NUISANCE_YAW,
                         source=scenario.task.source) for name in objects)
+
+
+def _rigid(scenario: Scenario, name: str) -> bool:
+    spec = scenario.object(name)
+    entry = ASSETS.get(spec.asset) if spec is not None else None
+    return entry is not None and entry.asset_class is AssetClass.RIGID
 
 
 def rules_of(scenario: Scenario, level: Level) -> list[LeveledRule]:

@@ -165,6 +165,15 @@ def test_an_l0_jitter_replaces_the_default_nuisance() -> None:
         ("pot", NUISANCE_DISTANCE, NUISANCE_YAW, 3)]  # the task's object, on the task's line
 
 
+def test_the_default_nuisance_leaves_articulated_task_objects_in_place(
+        builtin: dict[str, Scenario]) -> None:
+    drawer = builtin["open_drawer_then_insert"]  # insert(object=knife, target=cabinet)
+    assert [r.target for _, r in rules_of(drawer, "L0")] == ["knife"]
+    for seed in SEEDS:
+        variant = generate_variant(drawer, "L0", seed, allowed_roots=[SCENARIOS])
+        assert _xy(variant, "cabinet").tolist() == [0.2, 0.0]
+
+
 def test_an_infeasible_canonical_layout_is_diagnosed_at_l0_before_any_nuisance() -> None:
     text = POT_AND_STOVE.replace("at (30 cm, 0) on table", "at (12 cm, 0) on table")
     with pytest.raises(VariantError) as raised:
