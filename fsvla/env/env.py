@@ -102,7 +102,7 @@ class FsvlaEnv(gymnasium.Env):
         cameras: Sequence[str] | None = None,
         resolution: tuple[int, int] | str | None = None,
         shader: str = DEFAULT_SHADER,
-        lazy_images: bool = True,
+        lazy_images: bool = False,
     ) -> None:
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode must be one of {', '.join(OBS_MODES)}, got {obs_mode!r}")

@@ -2,15 +2,18 @@
 
 Rendering is the real cost of an rgb episode (two 320×240 cameras on lavapipe take
 tens of milliseconds a step), and a policy that returns a chunk of actions looks at one
-observation in many. So ``obs["images"]`` is a :class:`LazyImages`: a dict whose
-pictures are rendered the first time one of them is read, for the step that produced
-the observation, and kept. A step whose pictures nobody reads renders nothing. Physics
-never reads a picture, so an episode's states are the same whichever steps are rendered.
+observation in many. An environment made with ``lazy_images=True`` (the runner makes
+them so) returns ``obs["images"]`` as a :class:`LazyImages`: a dict whose pictures are
+rendered the first time one of them is read, for the step that produced the
+observation, and kept. A step whose pictures nobody reads renders nothing. Physics never
+reads a picture, so an episode's states are the same whichever steps are rendered.
 
 A picture can only be rendered while the scene is still at its step: reading the images
-of an observation after the environment has stepped again (or reset) raises
-:class:`StaleFrameError`. Read them before stepping, or make the environment with
-``lazy_images=False`` to render every step (the cost the lazy mapping saves).
+of such an observation after the environment has stepped again (or reset) raises
+:class:`StaleFrameError`. So the default (``lazy_images=False``) renders every step and
+returns plain dicts, as gymnasium's contract has it (an observation stays whole however
+long it is kept); the runner renders an observation in full before a policy sees it
+(:meth:`LazyImages.fill`), so a policy may keep the observations it is given.
 """
 
 from __future__ import annotations
@@ -45,6 +48,10 @@ class LazyImages(dict):
     def rendered(self) -> bool:
         """Whether the pictures have been rendered."""
         return self._render is None
+
+    def fill(self) -> None:
+        """Render the pictures now (nothing when they are): the observation is then whole."""
+        self._fill()
 
     def _fill(self) -> None:
         if self._render is not None:

@@ -7,7 +7,9 @@ a chunk ``(H, A)`` and executes the chunk itself, one control step per row (its 
 ``replan_steps`` rows, when given, as openpi's clients do), asking again when they are
 used up, so the monitor sees every action and every physics substep.
 Pictures are rendered only for the observations the policy is asked about (or that
-``on_frame`` reads): the environment renders ``obs["images"]`` when it is first read.
+``on_frame`` reads): the runner's environments render ``obs["images"]`` when it is first
+read, and :func:`play` renders an observation in full before ``act`` gets it, so a policy
+may keep it (a frame history) and read it later.
 
 Anything that goes wrong ends the episode with a :class:`Fault` naming the failure
 reason (``fsvla.results.FailureReason``): the policy raised (``policy_error``), returned
@@ -84,6 +86,15 @@ def episode_info(env: FsvlaEnv, spec: EpisodeSpec) -> EpisodeInfo:
         observation=ObservationSchema(state_layout=state_layout, cameras=cameras))
 
 
+def _whole(observation: dict[str, Any]) -> None:
+    """Render ``observation``'s pictures if they are lazy (see the module doc)."""
+    from fsvla.env.frames import LazyImages
+
+    images = observation.get("images")
+    if isinstance(images, LazyImages):
+        images.fill()
+
+
 def play(env: FsvlaEnv, policy: Policy, spec: EpisodeSpec, *, timeout: float | None = None,
          on_call: CallHook | None = None,
          on_frame: Callable[[dict[str, Any]], None] | None = None,
@@ -103,6 +114,7 @@ def play(env: FsvlaEnv, policy: Policy, spec: EpisodeSpec, *, timeout: float | N
     chunk: deque[np.ndarray] = deque()
     while True:
         if not chunk:
+            _whole(observation)
             answer = _policy_call(policy.act, observation, timeout, "act()", on_call)
             chunk.extend(as_chunk(answer, env.codec.size)[:replan_steps])
         action = chunk.popleft()

@@ -104,8 +104,8 @@ def _moves(env: Any, obs: dict[str, Any], steps: int) -> list[np.ndarray]:
 def test_lazy_pictures_are_the_eager_ones_of_the_steps_read(short: Path, render_device) -> None:
     from fsvla.env import make
 
-    lazy = make(short, obs_mode="rgb", vision="V4", seed=1)
-    eager = make(short, obs_mode="rgb", vision="V4", seed=1, lazy_images=False)
+    lazy = make(short, obs_mode="rgb", vision="V4", seed=1, lazy_images=True)
+    eager = make(short, obs_mode="rgb", vision="V4", seed=1)
     obs_l, _ = lazy.reset()
     obs_e, _ = eager.reset()
     assert isinstance(obs_l["images"], LazyImages) and type(obs_e["images"]) is dict
@@ -127,7 +127,7 @@ def test_lazy_pictures_are_the_eager_ones_of_the_steps_read(short: Path, render_
 def test_pictures_of_a_past_step_are_refused(short: Path, render_device) -> None:
     from fsvla.env import make
 
-    env = make(short, obs_mode="rgb", cameras=["front"], resolution="64x48")
+    env = make(short, obs_mode="rgb", cameras=["front"], resolution="64x48", lazy_images=True)
     old, _ = env.reset()
     assert old["images"]["front"].shape == (48, 64, 3)  # read in time: kept
     unread, *_ = env.step(_hold(env, old))
@@ -157,8 +157,8 @@ def test_the_state_trace_is_the_same_whichever_steps_are_rendered(short: Path,
         return env.episode_record().to_dict(), states
 
     state_only = episode()
-    lazy = episode(obs_mode="rgb")
-    eager = episode(obs_mode="rgb", lazy_images=False)
+    lazy = episode(obs_mode="rgb", lazy_images=True)
+    eager = episode(obs_mode="rgb")
     for other in (lazy, eager):
         assert other[0] == state_only[0]
         assert all(np.array_equal(a, b) for a, b in zip(other[1], state_only[1], strict=True))
@@ -200,3 +200,45 @@ def test_a_ten_step_chunk_policy_renders_one_step_in_ten(short: Path, tmp_path: 
     result = execute_run(prepare_run(config), tmp_path / "run", make_backend("process", config, 0))
     assert result.recorded == 1 and not result.faults
     assert len(renders) == 2  # 20 steps: the pictures at the reset and after step 10
+
+
+class RememberingChunks(LookingChunks):
+    """Keeps every observation it is shown and reads the one before at each query (a
+    frame history, as policies with several observation steps keep)."""
+
+    name = "remembering-chunks"
+
+    def reset(self, episode: Any) -> None:
+        super().reset(episode)
+        self.seen: list[dict[str, Any]] = []
+
+    def act(self, observation: dict[str, Any]) -> np.ndarray:
+        from fsvla.policies.simple import hold_action
+
+        self.seen.append(observation)  # its pictures are not read now
+        if len(self.seen) > 1:
+            assert self.seen[-2]["images"]["front"].shape == (48, 64, 3)
+        return np.tile(hold_action(observation, "joint_pos", self.sizes), (10, 1))
+
+
+@pytest.mark.sim
+@pytest.mark.render
+def test_a_policy_may_read_an_observation_it_kept(short: Path, tmp_path: Path,
+                                                  render_device) -> None:
+    from fsvla.runner import execute_run, make_backend, make_config, prepare_run
+
+    config = make_config(policy=f"{__file__}:RememberingChunks", scenarios=(str(short),),
+                         warmup=0, obs_mode="rgb", resolution=(64, 48))
+    result = execute_run(prepare_run(config), tmp_path / "run", make_backend("process", config, 0))
+    assert result.recorded == 1 and not result.faults, dict(result.faults)
+
+
+@pytest.mark.sim
+@pytest.mark.render
+def test_a_default_env_keeps_every_observation_whole(short: Path, render_device) -> None:
+    from fsvla.env import make
+
+    env = make(short, obs_mode="rgb", cameras=["front"], resolution="64x48")
+    first, _ = env.reset()
+    env.step(_hold(env, first))
+    assert type(first["images"]) is dict and first["images"]["front"].shape == (48, 64, 3)
