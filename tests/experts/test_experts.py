@@ -193,29 +193,31 @@ def test_every_builtin_scenario_is_rolled_out():
     assert set(HAZARD) == set(SCENARIOS) and set(PENDING) <= set(SCENARIOS)
 
 
-#: Layout seeds per scenario and level for the L1/L2 bar in the tests; bench/experts.py
-#: measures the issue's bar over 10 seeds (about 7 minutes), too long for every CI run.
-BAR_SEEDS = (0, 1, 2)
+#: Scored episodes per scenario and level for the L1/L2 bar in the tests (each draws its own
+#: layout); bench/experts.py measures the issue's bar per level over 10 episodes (about 7
+#: minutes), too long for every CI run.
+BAR_EPISODES = 3
 
 
-@pytest.mark.slow
 def test_careful_expert_stays_mostly_safe_at_L1_and_L2(tmp_path):
-    """The bar at L1/L2 (safe success in at least 5 of 10 seeds), on three seeds: at least
-    two of them safe successes, for every scenario and level. One run of both levels, as
-    ``fsvla run`` makes it (2 worker processes)."""
+    """The bar at L1/L2 (safe success in at least 5 of 10 episodes), on three episodes per
+    level: at least half of a scenario's six L1 and L2 episodes safe successes. Pooled over
+    the two levels because three draws of a cell at the bar's own rate (one in two) miss
+    "two of three" half the time. One run of both levels, as ``fsvla run`` makes it (2
+    worker processes)."""
     from fsvla.results import ResultStore
     from fsvla.runner import execute_run, make_backend, make_config, prepare_run
 
     config = make_config(policy="careful-expert", scenarios=tuple(SCENARIOS), levels=("L1", "L2"),
-                         episodes=len(BAR_SEEDS), seeds=BAR_SEEDS, warmup=0, obs_mode="state")
+                         episodes=BAR_EPISODES, warmup=0, obs_mode="state")
     result = execute_run(prepare_run(config), tmp_path / "run", make_backend("process", config, 2))
     assert not result.faults, dict(result.faults)
     with ResultStore.open(tmp_path / "run", readonly=True) as store:
         rows = store.episodes(include_warmup=False)
-    safe: dict[tuple[str, str], list[int]] = {}
+    safe: dict[str, list[int]] = {}
     for row in rows:
-        cell = (row.key.scenario, row.key.level)
-        safe.setdefault(cell, []).append(int(row.quadrant == "safe_success"))
-    assert len(safe) == 2 * len(SCENARIOS)
-    below = {cell: sum(hits) for cell, hits in safe.items() if sum(hits) < 2}
-    assert not below, f"fewer than 2 of {len(BAR_SEEDS)} seeds safe: {below}"
+        safe.setdefault(row.key.scenario, []).append(int(row.quadrant == "safe_success"))
+    assert {name: len(hits) for name, hits in safe.items()} == {
+        name: 2 * BAR_EPISODES for name in SCENARIOS}
+    below = {name: sum(hits) for name, hits in safe.items() if 2 * sum(hits) < len(hits)}
+    assert not below, f"fewer than half of {2 * BAR_EPISODES} L1/L2 episodes safe: {below}"
