@@ -368,6 +368,18 @@ def _rgb_unavailable() -> str | None:
 
 # --------------------------------------------------------------------------- main
 
+def _bar(label: str, rows: Sequence[Any], ratios: list[float], target: float) -> bool | None:
+    """Print one bar's verdict over ``rows`` (their ``ratios``); None when nothing was measured."""
+    if not rows:
+        print(f"{label}: not measured: the bar is not checked")
+        return None
+    worst = max(range(len(rows)), key=ratios.__getitem__)
+    ok = all(ratio <= target for ratio in ratios)
+    print(f"{label}: the monitor adds at most {_verdict(ratios[worst], target)} "
+          f"({rows[worst].scenario}): {'PASS' if ok else 'FAIL'}")
+    return ok
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--steps", type=int, default=300, help="timed control steps per env, scenario and motion")
@@ -446,24 +458,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     else:
         print(f"RGB: not measured: {rgb_missing}")
     print()
-    verdicts = []
     barred = [r for r in summary if r.motion == BARRED]
-    if barred:
-        worst = max(barred, key=lambda r: r.mean_ratio)
-        ok = all(r.mean_ratio <= STATE_TARGET for r in barred)
-        verdicts.append(ok)
-        print(f"state-only, {BARRED} episodes: the monitor adds at most {_verdict(worst.mean_ratio, STATE_TARGET)} "
-              f"({worst.scenario}): {'PASS' if ok else 'FAIL'}")
-    else:
-        print(f"state-only: no {BARRED} episodes measured: the bar is not checked")
-    if rgb_rows:
-        worst_rgb = max(rgb_rows, key=lambda r: r.ratio)
-        ok = all(r.ratio <= RGB_TARGET for r in rgb_rows)
-        verdicts.append(ok)
-        print(f"rgb episodes: the monitor adds at most {_verdict(worst_rgb.ratio, RGB_TARGET)} "
-              f"({worst_rgb.scenario}): {'PASS' if ok else 'FAIL'}")
-    else:
-        print("rgb episodes: not measured: the bar is not checked")
+    verdicts = [verdict for verdict in (
+        _bar(f"state-only, {BARRED} episodes", barred, [r.mean_ratio for r in barred], STATE_TARGET),
+        _bar("rgb episodes", rgb_rows, [r.ratio for r in rgb_rows], RGB_TARGET)) if verdict is not None]
     complete = bool(barred) and bool(rgb_rows)
     overall = ("PASS" if all(verdicts) else "FAIL") if complete else ("FAIL" if not all(verdicts) else "INCOMPLETE")
     print(f"verdict: {overall}  [{time.perf_counter() - started:.0f} s]")
