@@ -4,11 +4,15 @@
 
 What it runs, as a user would (every step is a plain ``fsvla`` command, printed first):
 
-1. ``fsvla run`` of the careful and of the careless expert over the ten built-in
-   scenarios x L0-L2 x W0-W4 x V0, one layout seed per cell, one warm-up per
-   scenario; state observations (the experts read the simulator state, so they do not
-   look at the pictures: V1-V4 would only add rendering time, about a minute per episode
-   on a CPU-only machine, and change no outcome);
+1. ``fsvla run --sweep`` of the careful and of the careless expert over the ten built-in
+   scenarios: the paper's one-axis sweeps (L0-L2 at W0/V0, W0-W4 at L0/V0, V0-V4 at
+   L0/W0: 11 cells a scenario), each scored episode with its own layout, one warm-up per
+   scenario; rgb observations, so V1-V4 are rendered into the pictures the policy is
+   given (the experts read the simulator state and ignore them, which is what their flat
+   W and V curves show). The careful expert gets three episodes a cell; the careless one
+   gets one, ended at its first hard violation (``--terminate-on-violation``): its
+   collisions make a whole episode about ten times as slow to simulate, and the report
+   needs its outcome, not how long it went on being unsafe;
 2. ``fsvla report`` once, as JSON only, to learn which episode it dissects (the unsafe
    success with the largest RET);
 3. ``fsvla replay --video`` of that episode into its run's ``videos/`` folder, so the
@@ -31,8 +35,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 EXPERTS = ("careful-expert", "careless-expert")
-GRID = ["--scenarios", "scenarios/", "--levels", "L0-L2", "--language", "W0-W4",
-        "--vision", "V0", "--seeds", "1", "--episodes", "1", "--warmup", "1"]
+GRID = ["--scenarios", "scenarios/", "--sweep", "--obs-mode", "rgb", "--warmup", "1"]
+PER_EXPERT = {"careful-expert": ["--episodes", "3"],
+              "careless-expert": ["--episodes", "1", "--terminate-on-violation"]}
 FORMATS = "html,md,json,tex,png,csv"
 
 
@@ -50,7 +55,7 @@ def main() -> None:
     args = parser.parse_args()
     folders = {expert: args.runs / expert.split("-")[0] for expert in EXPERTS}
     for expert, folder in folders.items():
-        fsvla("run", "--policy", expert, *GRID, "--workers", args.workers,
+        fsvla("run", "--policy", expert, *GRID, *PER_EXPERT[expert], "--workers", args.workers,
               "--out", str(folder), "--no-progress")
     runs = [str(folders[e]) for e in EXPERTS]
     with tempfile.TemporaryDirectory(prefix="fsvla-example-") as scratch:
