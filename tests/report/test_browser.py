@@ -140,7 +140,8 @@ def test_page_opens_without_console_errors(browser: str, written: Path) -> None:
         # Sorting: click SSR of the aggregate table twice (ascending, then descending).
         order = page.evaluate("""(() => {
             const table = document.getElementById('t-aggregate');
-            const th = table.tHead.rows[table.tHead.rows.length - 1].cells[2];
+            const heads = Array.from(table.tHead.rows[table.tHead.rows.length - 1].cells);
+            const th = heads.find(c => c.textContent.trim().startsWith('SSR'));
             const names = () => Array.from(table.tBodies[0].rows, r => r.cells[0].textContent);
             th.click(); const up = names(); th.click(); const down = names();
             return [up, down, th.getAttribute('aria-sort')];
