@@ -17,8 +17,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fsvla.compiler.assets.model import RigidAsset, Shape
-from fsvla.compiler.collision import pose_matrix
 from fsvla.compiler.monitor import BodyEntity, MonitorSpec, RobotEntity, ZoneEntity
+from fsvla.compiler.pose import pose_matrix
 from fsvla.compiler.scene import SceneSpec
 
 from .geometry import SceneGeometry

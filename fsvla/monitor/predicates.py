@@ -33,8 +33,8 @@ from functools import cache
 import numpy as np
 
 from fsvla.compiler.assets.model import Shape
-from fsvla.compiler.collision import pose_matrix
 from fsvla.compiler.monitor import MonitorSpec
+from fsvla.compiler.pose import pose_matrix
 from fsvla.dsl.catalog import PREDICATES
 from fsvla.dsl.models import AllOf, AnyOf, Condition, Not, Predicate, predicates_in
 

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 from fsvla.compiler.assets.model import BoxShape
-from fsvla.compiler.collision import pose_matrix
 from fsvla.compiler.monitor import lower_monitor
+from fsvla.compiler.pose import pose_matrix
 from fsvla.compiler.scene import lower_scene
 from fsvla.dsl.loader import ScenarioLoader
 

@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 import pytest
-from fsvla.compiler.collision import min_distance, pieces_of, pose_matrix
+from fsvla.compiler.collision import min_distance, pieces_of
 from fsvla.compiler.monitor import METRIC_NAMES
+from fsvla.compiler.pose import pose_matrix
 
 from fsvla.monitor.channels import MEASURES
 
