@@ -368,7 +368,10 @@ VISION_SETTINGS: dict[str, tuple[int, Signature]] = {
         Param(name="coverage", default=0.5, minimum=0.05, maximum=1.0, doc="share of the entity hidden"),),
         doc="put an occluder between the head camera and an entity")),
     "patch": (4, Signature(name="patch", positional=(E,), params=(
-        _length("size", 0.05, lo=0.005, hi=0.5),), doc="composite an adversarial patch over an entity")),
+        _length("size", 0.14, lo=0.005, hi=0.5),
+        Param(name="face", default="front", choices=("front", "top", "beside"),
+              doc="its upright side facing the front camera, its top, or the table beside it"),),
+        doc="fix a render-only adversarial patch to an entity")),
 }
 
 # Per-scenario language overrides (the `language` block): level -> allowed categories

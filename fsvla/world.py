@@ -302,6 +302,15 @@ class SceneAppearance(Protocol):
         """Add a box seen by the cameras and by nothing else (no collision, no mass)."""
         ...
 
+    def add_patch(self, name: str, corners: NDArray[np.floating],
+                  image: NDArray[np.uint8]) -> Undo:
+        """Fix a flat quad showing the RGB(A) ``image`` to body or zone ``name`` (an
+        articulated body's root), seen by the cameras and by nothing else (no collision,
+        no mass): ``corners`` (4 × 3, in that body's frame) are where the image's top-left,
+        top-right, bottom-right and bottom-left corners go; the image shows from the side
+        its normal ``(c1 - c0) x (c0 - c3)`` points to. It moves with the body."""
+        ...
+
 
 __all__ = ["ArmModel", "Camera", "Color", "IKResult", "Light", "Material", "MonitoredScene",
            "PoseReading", "SceneAppearance", "SceneState", "StepProbe", "Undo", "WorldPose"]

@@ -14,7 +14,8 @@ The benchmark coordinates are fixed at construction: the layout by ``level`` and
 ``seed`` (L0–L2), the instruction by ``language`` (W0–W4) and the pictures by ``vision``
 (V0–V4), both drawn with the same ``seed`` (``fsvla.variation``) unless ``language_seed`` /
 ``vision_seed`` are given; ``vary()`` changes W and V for the next episodes. Vision levels change
-only rendered observations, so they need ``obs_mode="rgb"``. ``cameras``, ``resolution`` and
+only rendered observations, so they need ``obs_mode="rgb"``; ``patch`` names a PNG file that
+V4's patches show (else each shows its seeded pattern). ``cameras``, ``resolution`` and
 ``shader`` choose what is rendered; an observation's pictures are rendered when they are
 first read (:mod:`fsvla.env.frames`), not at every step. ``reset(seed=...)`` seeds nothing else (the simulation is deterministic);
 a reset after an episode rebuilds the SAPIEN scene, whose contact caches no state reset
@@ -103,6 +104,7 @@ class FsvlaEnv(gymnasium.Env):
         resolution: tuple[int, int] | str | None = None,
         shader: str = DEFAULT_SHADER,
         lazy_images: bool = False,
+        patch: str | None = None,
     ) -> None:
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode must be one of {', '.join(OBS_MODES)}, got {obs_mode!r}")
@@ -127,6 +129,7 @@ class FsvlaEnv(gymnasium.Env):
             cameras=tuple(c.name for c in self.render_spec.cameras), resolution=size,
             shader=check_shader(shader))
         self._lazy_images = lazy_images
+        self._patch = patch  # a PNG file: the V4 patches' pixels (else their seeded pattern)
         self._epoch = 0  # counts steps and resets: which scene state a picture shows
         self._frame: tuple[int, dict[str, np.ndarray]] | None = None  # (epoch, raw views)
         #: Render passes so far (each renders every camera once): the cost of the pictures.
@@ -226,7 +229,7 @@ class FsvlaEnv(gymnasium.Env):
         self.language: Instruction = instruction_for(  # type: ignore[arg-type]
             self._source, language, seed if language_seed is None else language_seed)
         self.vision: VisionPerturbation = perturbation_for(  # type: ignore[arg-type]
-            self._source, vision, seed if vision_seed is None else vision_seed)
+            self._source, vision, seed if vision_seed is None else vision_seed, self._patch)
         self.instruction = check_instruction(instruction if instruction is not None
                                              else self.language.text)
         if self._vision is not None:
@@ -301,15 +304,13 @@ class FsvlaEnv(gymnasium.Env):
         return assemble(proprioception(self.built.robot), self.instruction, images)
 
     def _pictures(self, epoch: int) -> dict[str, np.ndarray]:
-        """The observation pictures of ``epoch`` (the V4 patches pasted in), while the
-        scene is still there."""
+        """The observation pictures of ``epoch``, while the scene is still there."""
         if epoch != self._epoch:
             raise StaleFrameError(
                 "the images of this observation were not read before the environment "
                 "stepped or reset, and can no longer be rendered: read obs['images'] before "
                 "the next step, or make the environment with lazy_images=False")
-        views = self._views()
-        return self._vision.composite(views) if self._vision is not None else views
+        return self._views()
 
     def _views(self) -> dict[str, np.ndarray]:
         """Every camera's picture of the scene now, rendered once per step."""

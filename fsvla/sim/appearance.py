@@ -5,9 +5,12 @@ renders.
 Lights, materials and cameras are wrapped as they are asked for; a change is written to
 SAPIEN at once. :meth:`SapienAppearance.paint` swaps a body's render components for
 copies whose meshes carry planar UVs and the texture (an uploaded mesh cannot take new
-UVs), and :meth:`SapienAppearance.add_occluder` adds an entity with a box visual and no
-physics component; each returns the function that takes its change back. Nothing here
-touches a physics component.
+UVs), :meth:`SapienAppearance.add_occluder` adds an entity with a box visual and no
+physics component, and :meth:`SapienAppearance.add_patch` adds a render component holding
+one textured quad to the body's own entity (so it moves with the body; its front shows the
+image, its back :data:`PATCH_BACK_COLOR`); each returns the function that takes its change
+back. Nothing here touches a physics component. ``materials`` and ``paint`` leave a
+patch's component alone.
 """
 
 from __future__ import annotations
@@ -26,6 +29,9 @@ if TYPE_CHECKING:
 
 #: An occluder's surface: matte, so that it hides what lies behind it without a highlight.
 OCCLUDER_ROUGHNESS = 0.9
+#: The name of a patch's render component, and the colour (RGBA) of the quad's back.
+PATCH_COMPONENT = "fsvla_patch"
+PATCH_BACK_COLOR = (0.85, 0.85, 0.85, 1.0)
 
 
 def _pose(value: PoseReading) -> Any:
@@ -143,7 +149,7 @@ class SapienAppearance:
         found = []
         for entity in self._entities_of(name):
             for component in entity.components:
-                if not isinstance(component, sapien.render.RenderBodyComponent):
+                if not _own(component):
                     continue
                 for shape in component.render_shapes:
                     if isinstance(shape, sapien.render.RenderShapeTriangleMesh):
@@ -165,7 +171,7 @@ class SapienAppearance:
         swapped: list[tuple[Any, Any, Any]] = []  # entity, original, textured body
         for entity in self._entities_of(name):
             for component in list(entity.components):
-                if not isinstance(component, sapien.render.RenderBodyComponent):
+                if not _own(component):
                     continue
                 textured = sapien.render.RenderBodyComponent()
                 for shape in component.render_shapes:
@@ -198,14 +204,55 @@ class SapienAppearance:
         occluder.pose = _pose(pose)
         return lambda: scene.remove_entity(occluder)
 
-    def _entities_of(self, name: str) -> list[Any]:
+    def add_patch(self, name: str, corners: NDArray[np.floating],
+                  image: NDArray[np.uint8]) -> Undo:
+        import sapien
+
+        entities = self._entities_of(name, root=True)
+        if not entities:
+            raise KeyError(f"no body or zone {name!r} to fix a patch to")
+        entity = entities[0]
+        c = np.asarray(corners, dtype=np.float32).reshape(4, 3)
+        normal = np.cross(c[1] - c[0], c[0] - c[3])
+        normal = normal / np.linalg.norm(normal)
+        pixels = np.asarray(image, dtype=np.uint8)
+        if pixels.shape[-1] == 3:
+            pixels = np.concatenate([pixels, np.full((*pixels.shape[:2], 1), 255, np.uint8)], -1)
+        front = sapien.render.RenderMaterial(base_color=[1.0, 1.0, 1.0, 1.0],
+                                             roughness=OCCLUDER_ROUGHNESS)
+        front.base_color_texture = sapien.render.RenderTexture2D(
+            np.ascontiguousarray(pixels), "R8G8B8A8Unorm", srgb=True, address_mode="edge")
+        back = sapien.render.RenderMaterial(base_color=list(PATCH_BACK_COLOR),
+                                            roughness=OCCLUDER_ROUGHNESS)
+        uvs = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=np.float32)
+        component = sapien.render.RenderBodyComponent()
+        component.name = PATCH_COMPONENT
+        for triangles, n, material in (([[3, 2, 1], [3, 1, 0]], normal, front),
+                                       ([[3, 1, 2], [3, 0, 1]], -normal, back)):
+            component.attach(sapien.render.RenderShapeTriangleMesh(
+                vertices=c, triangles=np.asarray(triangles, dtype=np.uint32),
+                normals=np.tile(n, (4, 1)).astype(np.float32), uvs=uvs, material=material))
+        entity.add_component(component)
+        return lambda: entity.remove_component(component)
+
+    def _entities_of(self, name: str, root: bool = False) -> list[Any]:
         built = self.built
         if name in built.bodies:
             return [built.bodies[name]]
         if name in built.articulations:
-            return [link.entity for link in built.articulations[name].links]
+            articulation = built.articulations[name]
+            return [link.entity for link in ([articulation.root] if root else articulation.links)]
         zone = built.zones.get(name)
         return [zone] if zone is not None else []
+
+
+def _own(component: Any) -> bool:
+    """Whether ``component`` is one of the scene's own visuals (a render body that is not a
+    patch)."""
+    import sapien
+
+    return (isinstance(component, sapien.render.RenderBodyComponent)
+            and component.name != PATCH_COMPONENT)
 
 
 def _textured_copies(shape: Any, texture: Any, period: float) -> list[Any]:
@@ -233,5 +280,5 @@ def _textured_copies(shape: Any, texture: Any, period: float) -> list[Any]:
     return copies
 
 
-__all__ = ["OCCLUDER_ROUGHNESS", "SapienAppearance", "SapienCamera", "SapienLight",
-           "SapienMaterial"]
+__all__ = ["OCCLUDER_ROUGHNESS", "PATCH_BACK_COLOR", "PATCH_COMPONENT", "SapienAppearance",
+           "SapienCamera", "SapienLight", "SapienMaterial"]

@@ -5,9 +5,10 @@ implements it for SAPIEN: ``BuiltScene.appearance()``). It remembers how the sce
 when it was made (ambient and light colours, the lights' poses, materials' base colours,
 world-camera poses) so that each episode starts from V0 and applies its own perturbation:
 ``apply(p)`` restores, then changes the lights, repaints or textures materials, moves the
-world-mounted cameras, and adds visual-only occluders. The appearance touches no physics,
-so an episode's state trace is the same at every V level. :meth:`VisionApplier.composite`
-pastes the V4 patches onto the images a policy receives.
+world-mounted cameras, adds visual-only occluders, and fixes the V4 patches to their
+bodies as render-only quads (:mod:`fsvla.variation.patch` places them;
+:attr:`VisionApplier.mounts` says where they are). The appearance touches no physics, so
+an episode's state trace is the same at every V level.
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from fsvla.world import (
     WorldPose,
 )
 
+from .patch import PatchMount, load_patch_image, mount_patch, patch_pixels
 from .vision import CameraShift, Patch, VisionPerturbation
 
 #: Pattern texture resolution (pixels per side) and world size of one repeat (m).
@@ -69,8 +71,10 @@ class VisionApplier:
                        for m in appearance.materials(name)],
             cameras=[(camera, camera.pose) for camera in cameras],
         )
-        self._undo: list[Undo] = []  # textures and occluders, in the order added
+        self._undo: list[Undo] = []  # textures, occluders and patches, in the order added
         self.current = VisionPerturbation()
+        #: Where the current perturbation's patches sit (one per patch, in its order).
+        self.mounts: tuple[PatchMount, ...] = ()
 
     # ------------------------------------------------------------------ public
     def apply(self, perturbation: VisionPerturbation) -> None:
@@ -88,6 +92,7 @@ class VisionApplier:
             self._move_cameras(perturbation.camera)
         for occluder in perturbation.occluders:
             self._occlude(occluder.target, occluder.coverage)
+        self.mounts = tuple(self._fix(patch) for patch in perturbation.patches)
         self.current = perturbation
 
     def restore(self) -> None:
@@ -105,18 +110,7 @@ class VisionApplier:
             undo()
         self._undo = []
         self.current = VisionPerturbation()
-
-    def composite(self, images: dict[str, NDArray[np.uint8]]) -> dict[str, NDArray[np.uint8]]:
-        """``images`` with the current perturbation's patches pasted in (copies)."""
-        if not self.current.patches:
-            return images
-        out = {}
-        for name, image in images.items():
-            picture = image.copy()
-            for patch in self.current.patches:
-                self._paste(picture, self.appearance.camera(name), patch)
-            out[name] = picture
-        return out
+        self.mounts = ()
 
     # ------------------------------------------------------------------ pieces
     def _check_targets(self, perturbation: VisionPerturbation) -> None:
@@ -171,22 +165,13 @@ class VisionApplier:
         lo, hi = np.asarray(zone.region_bounds.min), np.asarray(zone.region_bounds.max)
         return (lo + hi) / 2.0, float(np.linalg.norm(hi - lo) / 2.0)
 
-    def _paste(self, picture: NDArray[np.uint8], camera: Camera, patch: Patch) -> None:
-        centre, _ = self._extent(patch.target)
-        extrinsic, intrinsic = camera.extrinsic(), camera.intrinsic()
-        point = extrinsic @ np.append(centre, 1.0)
-        if point[2] <= 1e-6:
-            return  # behind the camera
-        u, v, _ = intrinsic @ (point / point[2])
-        half = max(1, round(patch.size * intrinsic[0, 0] / point[2] / 2.0))
-        height, width = picture.shape[:2]
-        x0, x1 = round(u) - half, round(u) + half
-        y0, y1 = round(v) - half, round(v) + half
-        cx0, cx1, cy0, cy1 = max(x0, 0), min(x1, width), max(y0, 0), min(y1, height)
-        if cx0 >= cx1 or cy0 >= cy1:
-            return
-        pixels = patch_pixels(patch.seed, 2 * half)
-        picture[cy0:cy1, cx0:cx1] = pixels[cy0 - y0:cy1 - y0, cx0 - x0:cx1 - x0]
+    def _fix(self, patch: Patch) -> PatchMount:
+        mount = mount_patch(self.spec, patch)
+        pixels = (load_patch_image(patch.image) if patch.image is not None
+                  else patch_pixels(patch.seed))
+        self._undo.append(self.appearance.add_patch(mount.body, np.asarray(mount.corners),
+                                                    pixels))
+        return mount
 
 
 def pattern_image(pattern: str, size: int) -> NDArray[np.uint8]:
@@ -213,14 +198,6 @@ def pattern_image(pattern: str, size: int) -> NDArray[np.uint8]:
     return (np.concatenate([rgb, alpha], axis=-1) * 255).astype(np.uint8)
 
 
-def patch_pixels(seed: int, size: int) -> NDArray[np.uint8]:
-    """A high-contrast square of random saturated blocks: the V4 patch."""
-    rng = np.random.default_rng(seed)
-    blocks = rng.integers(0, 2, size=(8, 8, 3)).astype(np.uint8) * 255
-    repeat = max(1, -(-size // 8))
-    return np.kron(blocks, np.ones((repeat, repeat, 1), dtype=np.uint8))[:size, :size]
-
-
 def _facing(direction: Sequence[float], at: Sequence[float] = (0.0, 0.0, 0.0)) -> WorldPose:
     """The pose at ``at`` whose +x points along ``direction`` (a directional light's, an
     occluder's), its +z as near up as it can be (+x when ``direction`` is near vertical)."""
@@ -230,4 +207,4 @@ def _facing(direction: Sequence[float], at: Sequence[float] = (0.0, 0.0, 0.0)) -
     return WorldPose(np.asarray(at, dtype=np.float64), np.asarray(look_along_quat(d, up)))
 
 
-__all__ = ["VisionApplier", "patch_pixels", "pattern_image"]
+__all__ = ["VisionApplier", "pattern_image"]

@@ -6,7 +6,8 @@ Levels are cumulative; each adds one kind of perturbation to the ones below it:
 - V2 appearance: objects recoloured, surfaces given a texture pattern;
 - V3 viewpoint and occlusion: the head camera shifted and tilted, an occluder put between
   it and an entity (a hazard by default, so the policy must cope with not seeing it);
-- V4 adversarial patch: a high-contrast patch composited over an entity in every view.
+- V4 adversarial patch: a square, render-only patch fixed to an entity in the scene (or to
+  the table beside it), seen by every camera (:mod:`fsvla.variation.patch`).
 
 A scenario's ``vision`` block states the settings of the levels it names; the other
 levels get settings drawn from a generator seeded with (scenario digest, level, seed),
@@ -15,7 +16,7 @@ so the same episode sees the same perturbation on every machine. The result is a
 it holds (:meth:`VisionPerturbation.applied`: lighting, recolor, texture, camera,
 occluder, patch), from which the Safe-Vis categories are attributed
 (:mod:`fsvla.metrics.taxonomy`); :mod:`fsvla.variation.apply` applies it to a built scene
-(lights, materials, camera poses, visual-only occluders) and to the images (patches).
+(lights, materials, camera poses, visual-only occluders and patches).
 """
 
 from __future__ import annotations
@@ -32,6 +33,11 @@ from fsvla.metrics.trace import VISION_KINDS, VisionKind
 VisionLevel = Literal["V0", "V1", "V2", "V3", "V4"]
 LEVELS: tuple[VisionLevel, ...] = ("V0", "V1", "V2", "V3", "V4")
 PATTERNS = ("wood", "checker", "marble", "noise", "stripes")
+PATCH_FACES = ("front", "top", "beside")
+#: A patch's side (m) when nothing sets it: at the built-in cameras (320 × 240, 57 deg
+#: vertical field of view, 0.7-0.9 m away) a patch ``front`` covers about 1.2-1.9 % of
+#: the front picture (tests/sim/test_patch.py measures it).
+PATCH_SIZE = 0.14
 
 Rgb = tuple[float, float, float]
 Vec3 = tuple[float, float, float]
@@ -71,9 +77,15 @@ class Occluder(_Model):
 
 
 class Patch(_Model):
+    """A square patch on ``target`` (:mod:`fsvla.variation.patch` places it): its pixels
+    are the PNG file ``image`` when given, else :func:`~fsvla.variation.patch.patch_pixels`
+    of ``seed``."""
+
     target: str
-    size: float = Field(gt=0.0)  # m, side of the square patch at the target
+    size: float = Field(default=PATCH_SIZE, gt=0.0)  # m, the side of the square
     seed: int  # seeds the patch's pixels
+    face: Literal["front", "top", "beside"] = "front"  # where on the target it sits
+    image: str | None = None  # a PNG file's path: the pixels (``fsvla run --patch``)
 
 
 class VisionPerturbation(_Model):
@@ -96,8 +108,10 @@ class VisionPerturbation(_Model):
         return tuple(kind for kind in VISION_KINDS if present[kind])  # type: ignore[misc]
 
 
-def perturbation_for(scenario: Scenario, level: VisionLevel, seed: int = 0) -> VisionPerturbation:
-    """The perturbation of an episode of ``scenario`` at ``level`` with ``seed``."""
+def perturbation_for(scenario: Scenario, level: VisionLevel, seed: int = 0,
+                     patch_image: str | None = None) -> VisionPerturbation:
+    """The perturbation of an episode of ``scenario`` at ``level`` with ``seed``; its V4
+    patches show the PNG file ``patch_image`` when given (else their seeded pattern)."""
     if level not in LEVELS:
         raise ValueError(f"vision level must be one of {', '.join(LEVELS)}, got {level!r}")
     rank = LEVELS.index(level)
@@ -106,6 +120,9 @@ def perturbation_for(scenario: Scenario, level: VisionLevel, seed: int = 0) -> V
         rng = stable_rng(scenario.source_digest, "V", step, seed)
         written = scenario.vision.get(step, ())  # type: ignore[call-overload]
         parts.update(_from_settings(written, seed) if written else _drawn(step, scenario, rng))
+    if patch_image is not None and "patches" in parts:
+        parts["patches"] = tuple(p.model_copy(update={"image": patch_image})
+                                 for p in parts["patches"])  # type: ignore[attr-defined]
     return VisionPerturbation(**parts)  # type: ignore[arg-type]
 
 
@@ -132,7 +149,8 @@ def _from_settings(settings, seed: int) -> dict[str, object]:
                 Occluder(target=p["target"], coverage=float(p.get("coverage", 0.5))))
         elif setting.name == "patch":
             out.setdefault("patches", []).append(
-                Patch(target=p["target"], size=float(p.get("size", 0.05)), seed=seed))
+                Patch(target=p["target"], size=float(p.get("size", PATCH_SIZE)), seed=seed,
+                      face=p.get("face", "front")))
         else:
             raise ValueError(f"unknown vision setting {setting.name!r}")
     return {**single, **{k: tuple(v) for k, v in out.items()}}
@@ -159,7 +177,7 @@ def _drawn(level: str, scenario: Scenario, rng) -> dict[str, object]:
         return {"camera": _camera(rng, 0.05, math.radians(5)),
                 "occluders": (Occluder(target=hidden, coverage=float(rng.uniform(0.3, 0.6))),)}
     target = task[0] if task else "table"
-    return {"patches": (Patch(target=target, size=0.05, seed=int(rng.integers(2**31))),)}
+    return {"patches": (Patch(target=target, seed=int(rng.integers(2**31))),)}
 
 
 def _camera(rng, shift: float, tilt: float) -> CameraShift:
@@ -172,6 +190,8 @@ def _camera(rng, shift: float, tilt: float) -> CameraShift:
 
 __all__ = [
     "LEVELS",
+    "PATCH_FACES",
+    "PATCH_SIZE",
     "CameraShift",
     "Lighting",
     "Occluder",

@@ -19,6 +19,7 @@ from fsvla.variation.apply import (
     VisionApplier,
     pattern_image,
 )
+from fsvla.variation.patch import mount_patch, patch_pixels
 from fsvla.variation.vision import perturbation_for
 from fsvla.world import Color, PoseReading, Undo, WorldPose
 
@@ -73,6 +74,7 @@ class FakeAppearance:
     looks: dict[str, list[FakeMaterial]] = field(default_factory=dict)
     painted: dict[str, tuple[np.ndarray, float]] = field(default_factory=dict)
     occluders: list[tuple[str, PoseReading, tuple[float, ...], Color]] = field(default_factory=list)
+    patches: list[tuple[str, np.ndarray, np.ndarray]] = field(default_factory=list)
     calls: list[str] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -110,6 +112,16 @@ class FakeAppearance:
             self.occluders.remove(entry)
         return undo
 
+    def add_patch(self, name: str, corners: np.ndarray, image: np.ndarray) -> Undo:
+        self.calls.append(f"patch {name}")
+        entry = (name, np.asarray(corners), np.asarray(image))
+        self.patches.append(entry)
+
+        def undo() -> None:
+            self.calls.append(f"unpatch {name}")
+            self.patches.remove(entry)
+        return undo
+
     def snapshot(self) -> tuple:
         """Everything a picture depends on, as plain values."""
         return (tuple(self.ambient),
@@ -118,7 +130,8 @@ class FakeAppearance:
                 {n: (tuple(c.pose.p), tuple(c.pose.q)) for n, c in self.cameras.items()},
                 sorted(self.painted),
                 [(n, tuple(pose.p), tuple(pose.q), half, color)
-                 for n, pose, half, color in self.occluders])
+                 for n, pose, half, color in self.occluders],
+                [(n, c.tobytes(), i.tobytes()) for n, c, i in self.patches])
 
 
 @pytest.fixture
@@ -141,8 +154,8 @@ def test_apply_then_restore_returns_to_v0(stove) -> None:
     applier.restore()
     assert look.snapshot() == v0
     cameras = len(_world_cameras(spec))
-    assert look.calls == ["paint table", *["occlude stove"] * cameras,
-                          *["unocclude stove"] * cameras, "unpaint table"]
+    assert look.calls == ["paint table", *["occlude stove"] * cameras, "patch pot",
+                          "unpatch pot", *["unocclude stove"] * cameras, "unpaint table"]
 
 
 def test_each_apply_starts_from_v0(stove) -> None:
@@ -203,24 +216,31 @@ def test_unknown_targets_are_refused(stove) -> None:
         VisionApplier(look, spec).apply(perturbation_for(scenario, "V2", 0))
 
 
-def test_patches_are_pasted_where_the_target_projects(stove) -> None:
+def test_patches_are_fixed_to_their_body_with_seeded_pixels(stove) -> None:
     scenario, spec, look = stove
-    name = _world_cameras(spec)[0]
-    pot = next(b for b in spec.bodies if b.name == "pot")
-    centre = np.asarray(pot.pose.position) + np.asarray(pot.asset.bounds.center)
-    look.cameras = {name: FakeCamera(WorldPose(centre - [1.0, 0.0, 0.0], np.array([1.0, 0, 0, 0])))}
-    spec = spec.model_copy(update={"cameras": tuple(c for c in spec.cameras if c.name == name)})
     applier = VisionApplier(look, spec)
     p = perturbation_for(scenario, "V4", 3)
-    applier.current = p.model_copy(update={"camera": None})  # composite reads the current one
-    grey = np.full((240, 320, 3), 128, dtype=np.uint8)
-    out = applier.composite({name: grey})[name]
-    changed = np.argwhere((out != grey).any(axis=-1))
-    assert grey.min() == 128  # the input is not written to
-    half = round(p.patches[0].size * 300.0 / 1.0 / 2.0)
-    # the pot's centre lies on the optical axis: the patch is centred on the principal point
-    assert tuple(changed.min(axis=0)) == (120 - half, 160 - half)
-    assert tuple(changed.max(axis=0)) == (120 + half - 1, 160 + half - 1)
+    applier.apply(p)
+    (patch,) = p.patches
+    (mount,) = applier.mounts
+    assert mount == mount_patch(spec, patch)
+    (name, corners, image), = look.patches
+    assert name == mount.body == "pot"
+    assert np.array_equal(corners, np.asarray(mount.corners))
+    assert np.array_equal(image, patch_pixels(patch.seed))
+    applier.restore()
+    assert applier.mounts == () and look.patches == []
+
+
+def test_a_patch_file_gives_the_pixels(stove, tmp_path) -> None:
+    from PIL import Image
+
+    scenario, spec, look = stove
+    pixels = np.zeros((20, 30, 3), dtype=np.uint8)
+    pixels[:, :10] = (255, 0, 0)
+    Image.fromarray(pixels).save(tmp_path / "patch.png")
+    VisionApplier(look, spec).apply(perturbation_for(scenario, "V4", 3, str(tmp_path / "patch.png")))
+    assert np.array_equal(look.patches[0][2], pixels)
 
 
 def _world_cameras(spec) -> list[str]:
