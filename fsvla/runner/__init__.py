@@ -21,7 +21,7 @@ from typing import Any
 #: CLI's ``run``/``replay`` option parsing stay cheap.
 _HOMES = {
     "BACKENDS": "backend", "Backend": "backend", "BackendError": "backend",
-    "InProcessBackend": "backend", "make_backend": "backend",
+    "InProcessBackend": "backend", "Rerun": "backend", "make_backend": "backend",
     "Fault": "episode", "episode_info": "episode", "play": "episode",
     "RunListener": "loop", "RunResult": "loop", "execute_run": "loop",
     "PreparedRun": "prepare", "RunInputError": "prepare", "check_run_folder": "prepare",
@@ -48,6 +48,7 @@ __all__ = [
     "PreparedRun",
     "ReplayInputError",
     "ReplayResult",
+    "Rerun",
     "RunInputError",
     "RunListener",
     "RunResult",

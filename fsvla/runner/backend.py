@@ -15,6 +15,7 @@ flight per worker; then closed. Only the run loop's process writes the store.
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
 from typing import Protocol
 
 from fsvla.results.models import EpisodeOutcome
@@ -31,8 +32,19 @@ class BackendError(RuntimeError):
     """A backend that cannot start or keep its workers (not an episode's fault)."""
 
 
+@dataclass(frozen=True)
+class Rerun:
+    """An episode handed out again because the worker playing it was lost (a node that
+    died, a crashed actor): nothing of the lost attempt reached the run folder."""
+
+    episode_id: str
+    attempt: int  # the attempt that was lost: 1 for the first
+    reason: str  # why, e.g. "ActorDiedError: ..."
+
+
 class Backend(Protocol):
     name: str
+    reruns: list[Rerun]  # episodes handed out again this session (the Ray backend's only)
 
     def start(self) -> None: ...
 
@@ -49,6 +61,7 @@ class InProcessBackend:
     def __init__(self, config: RunConfig) -> None:
         self.worker = EpisodeWorker(config)
         self.size = 1
+        self.reruns: list[Rerun] = []
 
     def start(self) -> None:
         self.worker.start()
@@ -78,4 +91,5 @@ def make_backend(kind: str, config: RunConfig, workers: int,
     raise ValueError(f"Expect `kind` to be one of {', '.join(BACKENDS)}, actually: {kind!r}")
 
 
-__all__ = ["BACKENDS", "Backend", "BackendError", "Finished", "InProcessBackend", "make_backend"]
+__all__ = ["BACKENDS", "Backend", "BackendError", "Finished", "InProcessBackend", "Rerun",
+           "make_backend"]

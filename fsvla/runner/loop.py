@@ -36,6 +36,7 @@ class RunResult:
     skipped: int = 0  # already recorded when this session started
     recorded: int = 0  # recorded by this session
     faults: Counter[str] = field(default_factory=Counter)  # failure_reason -> episodes
+    reruns: int = 0  # episodes handed out again after their worker was lost (backend.reruns)
     interrupted: bool = False
     startup_s: float = 0.0  # starting the backend (workers, policy loading)
     episodes_s: float = 0.0  # from the first episode handed out to the last recorded
@@ -77,6 +78,7 @@ def execute_run(prepared: PreparedRun, out: Path, backend: Backend, *, extend: b
             except KeyboardInterrupt:
                 result.interrupted = True
             result.episodes_s = time.perf_counter() - clock
+            result.reruns = len(backend.reruns)
     finally:
         backend.close()
     return result

@@ -30,7 +30,7 @@ from typing import Any
 from fsvla.results.models import EpisodeOutcome
 from fsvla.run.config import RunConfig
 from fsvla.run.plan import EpisodeSpec
-from fsvla.runner.backend import BackendError, Finished
+from fsvla.runner.backend import BackendError, Finished, Rerun
 from fsvla.runner.worker import EpisodeWorker
 
 #: Seconds between looks at the workers' clocks while waiting for results.
@@ -116,6 +116,7 @@ class ProcessBackend:
         self._context = multiprocessing.get_context("spawn")
         self._slots: list[_Slot] = []
         self.replaced = 0  # workers killed or lost and started again
+        self.reruns: list[Rerun] = []  # none: a lost worker costs its episode (sim_error)
 
     # ------------------------------------------------------------------ lifecycle
     def start(self) -> None:
