@@ -103,3 +103,22 @@ class Dies(Hold):
 class Unbuildable:
     def __init__(self) -> None:
         raise RuntimeError("no weights here")
+
+
+#: Names the file a :class:`StallsWhereMarked` policy writes, in the environment of the
+#: Ray node it is to stall on (tests/runner/test_ray_cluster.py).
+STALL_MARKER = "FSVLA_TEST_STALL_MARKER"
+
+
+class StallsWhereMarked(Hold):
+    """Holds still, except in a process whose environment names a marker file: there its
+    first ``act()`` writes the episode's id to that file and then does not return (for
+    two minutes), so that the test can kill the node while the episode is in flight."""
+
+    def act(self, observation: dict[str, Any]) -> np.ndarray:
+        marker = os.environ.get(STALL_MARKER)
+        if marker:
+            with open(marker, "a", encoding="utf-8") as out:
+                out.write(f"{self.episode.episode_id}\n")
+            time.sleep(120)
+        return super().act(observation)

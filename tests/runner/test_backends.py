@@ -3,6 +3,7 @@ survives workers that hang or die."""
 
 from __future__ import annotations
 
+import importlib.util
 from pathlib import Path
 
 import pytest
@@ -11,6 +12,7 @@ from fsvla.results import ResultStore
 from fsvla.runner.pool import hard_limit
 from fsvla.runner.replay import compare_traces
 
+from ..conftest import require
 from .conftest import policy, run_into
 
 pytestmark = pytest.mark.sim
@@ -50,7 +52,8 @@ def test_the_process_pool_gives_the_same_episodes(grid, in_process, tmp_path) ->
 
 @pytest.mark.slow
 def test_ray_gives_the_same_episodes(grid, in_process, tmp_path) -> None:
-    pytest.importorskip("ray")
+    require(importlib.util.find_spec("ray") is not None, "ray is not installed: pip install "
+            "-e '.[dev]'")  # under CI=true a failure, not a skip
     result = run_into(tmp_path, grid, workers=2, backend="ray")
     assert (result.recorded, result.faults) == (9, {})
     assert_same_episodes(in_process, tmp_path)
