@@ -54,6 +54,7 @@ class RunConfig(BaseModel):
     cameras: tuple[str, ...] | None = None  # the cameras rendered; None: all of the embodiment's
     resolution: tuple[int, int] | None = None  # (width, height) of each; None: the cameras' own
     shader: Literal["minimal", "default", "rt"] = "minimal"  # the cameras' shader
+    patch: str | None = None  # a PNG file (absolute path): V4's patch pixels; None: seeded
 
     @field_validator("levels", "languages", "visions")
     @classmethod

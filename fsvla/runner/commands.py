@@ -25,7 +25,7 @@ _CONFIG_PARAMS = {
     "sasr_lambda": "sasr_lambda", "terminate_on_violation": "terminate_on_violation",
     "policy_timeout": "policy_timeout_s", "policy_profile": "policy_profile",
     "replan_steps": "replan_steps", "sweep": "sweep",
-    "cameras": "cameras", "resolution": "resolution", "shader": "shader",
+    "cameras": "cameras", "resolution": "resolution", "shader": "shader", "patch": "patch",
 }
 #: Options whose absence leaves the value to the profile, the stored run or a default.
 _DERIVED = frozenset({"obs_mode", "control_mode", "replan_steps"})
@@ -93,6 +93,9 @@ def _fail(message: str, code: int) -> None:
 @click.option("--shader", type=click.Choice(["minimal", "default", "rt"]), default="minimal",
               show_default=True, help="The cameras' shader: minimal (fast), default (lit, "
               "shadows) or rt (ray traced).")
+@click.option("--patch", default=None, metavar="FILE.png",
+              help="The pixels of V4's patch (e.g. what fsvla attack wrote). Default: a "
+                   "seeded high-contrast pattern per episode.")
 @click.option("--sasr-lambda", type=float, default=1.0, show_default=True, help="SASR's lambda.")
 @click.option("--terminate-on-violation", is_flag=True,
               help="End an episode at its first hard violation.")
@@ -155,7 +158,8 @@ def _config(ctx: click.Context, out_dir: Path, options: dict[str, Any]):  # -> R
         raise RunInputError("--out", str(problem)) from None
     fields: dict[str, Any] = stored.model_dump() if stored is not None else {}
     parsers = {"levels": parse_levels, "language": parse_languages, "vision": parse_visions,
-               "seeds": parse_seeds, "cameras": _parse_cameras, "resolution": _parse_resolution}
+               "seeds": parse_seeds, "cameras": _parse_cameras, "resolution": _parse_resolution,
+               "patch": _parse_patch}
     for name, field in _CONFIG_PARAMS.items():
         if stored is not None and name not in given:
             continue
@@ -212,6 +216,20 @@ def _parse_resolution(text: str | None) -> tuple[int, int] | None:
         return None if text is None else parse_resolution(text)
     except ValueError as err:
         raise RunInputError("--resolution", str(err)) from None
+
+
+def _parse_patch(text: str | None) -> str | None:
+    """The patch file's absolute path, once it reads as a PNG image."""
+    from fsvla.runner import RunInputError
+    from fsvla.variation.patch import PatchFileError, load_patch_image
+
+    if text is None:
+        return None
+    try:
+        load_patch_image(text)
+    except PatchFileError as err:
+        raise RunInputError("--patch", str(err)) from None
+    return str(Path(text).resolve())
 
 
 def _check_ray() -> None:

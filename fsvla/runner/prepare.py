@@ -23,7 +23,7 @@ OPTIONS: dict[str, str] = {
     "languages": "--language", "visions": "--vision", "episodes": "--episodes",
     "seeds": "--seeds", "warmup": "--warmup", "control_mode": "--control-mode",
     "obs_mode": "--obs-mode", "embodiment": "--embodiment", "sasr_lambda": "--sasr-lambda",
-    "cameras": "--cameras", "resolution": "--resolution", "shader": "--shader",
+    "cameras": "--cameras", "resolution": "--resolution", "shader": "--shader", "patch": "--patch",
     "terminate_on_violation": "--terminate-on-violation", "policy_timeout_s": "--policy-timeout",
     "policy_profile": "--policy-profile", "replan_steps": "--replan-steps", "sweep": "--sweep",
 }
@@ -93,6 +93,9 @@ def make_config(**fields: Any) -> RunConfig:
     if config.obs_mode == "state" and config.visions != ("V0",):
         raise RunInputError("--vision", f"{', '.join(v for v in config.visions if v != 'V0')} "
                             "change only the pictures a policy sees; they need --obs-mode rgb")
+    if config.patch is not None and "V4" not in config.visions:
+        raise RunInputError("--patch", "--patch gives V4's patch its pixels, and the run has no "
+                            f"V4 (--vision {','.join(config.visions)})")
     if config.policy_profile is not None:
         _check_profile(config)
     if config.embodiment is not None:

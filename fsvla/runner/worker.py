@@ -57,6 +57,7 @@ def make_env(spec: EpisodeSpec, config: RunConfig, *, render: bool = False,
                 language=key.language, vision=key.vision, language_seed=spec.language_seed,
                 vision_seed=spec.vision_seed, terminate_on_violation=config.terminate_on_violation,
                 cameras=config.cameras, resolution=config.resolution, shader=config.shader,
+                patch=config.patch,
                 render_mode="rgb_array" if render else None, lazy_images=True)
 
 

@@ -101,6 +101,37 @@ def test_the_cameras_of_a_run_are_stored_and_resumed(scenario: Path, tmp_path: P
     assert "resolution: [160, 120] in the run folder, [320, 240] now" in capsys.readouterr().err
 
 
+def test_a_patch_file_is_checked_stored_and_resumed(scenario: Path, tmp_path: Path,
+                                                    capsys) -> None:
+    import numpy as np
+    from PIL import Image
+
+    from fsvla.results import ResultStore
+
+    (tmp_path / "patch.jpg").write_bytes(b"\xff\xd8 not a png")
+    Image.fromarray(np.full((16, 16, 3), 200, dtype=np.uint8)).save(tmp_path / "patch.png")
+    base = ["run", "--policy", "hold-still", "--scenarios", str(scenario), "--warmup", "0",
+            "--workers", "0", "--cameras", "front", "--resolution", "80x60"]
+    for given, says in ((["--vision", "V4", "--patch", str(tmp_path / "nosuch.png")],
+                         f"--patch: patch file {tmp_path / 'nosuch.png'}: no such file"),
+                        (["--vision", "V4", "--patch", str(tmp_path / "patch.jpg")],
+                         f"--patch: patch file {tmp_path / 'patch.jpg'}: not a PNG image"),
+                        (["--patch", str(tmp_path / "patch.png")],
+                         "--patch gives V4's patch its pixels, and the run has no V4")):
+        assert run([*base, "--out", str(tmp_path / "never"), *given]) == 2
+        err = capsys.readouterr().err
+        assert says in err and "Traceback" not in err
+        assert not (tmp_path / "never").exists()
+
+    out = tmp_path / "patched"
+    assert run([*base, "--out", str(out), "--vision", "V4", "--patch",
+                str(tmp_path / "patch.png")]) == 0
+    with ResultStore.open(out, readonly=True) as store:
+        assert store.config.patch == str((tmp_path / "patch.png").resolve())
+    assert run(["run", "--out", str(out), "--workers", "0"]) == 0  # resumes with it
+    assert "1 already recorded" in capsys.readouterr().out
+
+
 def test_a_run_folder_holding_another_run_is_refused(scenario: Path, tmp_path: Path,
                                                      capsys) -> None:
     out = tmp_path / "exp"
