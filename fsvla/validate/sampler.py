@@ -147,7 +147,7 @@ def sample_scenarios(count: int, *, start: int = 0, deep: bool = True) -> list[S
     for i in range(start, start + count):
         task = tasks[i % len(tasks)]
         able = capable_embodiments(task)
-        found.append(sample_scenario(i, task=task, embodiment=able[(i + i // len(tasks)) % len(able)],
+        found.append(sample_scenario(i, task=task, embodiment=able[(i % len(tasks) + i // len(tasks)) % len(able)],
                                      deep=deep))
     return found
 
