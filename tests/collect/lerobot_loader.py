@@ -2,7 +2,7 @@
 
 LeRobot pulls in torch (gigabytes), so it is not a dependency of fsvla's test extra: it
 lives in the interpreter named by ``FSVLA_LEROBOT_PYTHON`` (``.ci/run`` builds one with
-``lerobot==0.3.3``, the last release that reads the v2.1 format) or in this one. The
+the current lerobot release, which reads the v3.0 format fsvla writes) or in this one. The
 loading runs in that interpreter as a subprocess and answers with JSON. Without either
 the tests skip, unless ``FSVLA_REQUIRE_LEROBOT=1`` (set by CI) turns that into a failure.
 """

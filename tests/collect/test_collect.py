@@ -23,7 +23,7 @@ def test_collect_keeps_safe_successes_and_resumes(tmp_path: Path) -> None:
     assert progress.kept == 1 and progress.attempts >= 1
     info = json.loads((out / "meta/info.json").read_text())
     assert info["total_episodes"] == 1 and info["robot_type"] == "panda"
-    table = pq.read_table(out / "data/chunk-000/episode_000000.parquet")
+    table = pq.read_table(out / "data/chunk-000/file-000.parquet")
     assert table.num_rows == info["total_frames"] > 20
     assert len(table.column("action").to_pylist()[0]) == 8
     # Asking for the same number again does nothing; the attempts are remembered.
@@ -46,7 +46,7 @@ def test_lerobot_loads_a_collected_demonstration(tmp_path: Path, render_device) 
     out = tmp_path / "demo"
     assert run(["collect", "stack_block_gently", "--episodes", "1", "-o", str(out)]) == 0
     info = json.loads((out / "meta/info.json").read_text())
-    table = pq.read_table(out / "data/chunk-000/episode_000000.parquet")
+    table = pq.read_table(out / "data/chunk-000/file-000.parquet")
     seen = load_with_lerobot(out)
     assert info["total_frames"] == table.num_rows
     assert (seen["episodes"], seen["frames"]) == (1, table.num_rows)
