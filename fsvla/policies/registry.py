@@ -8,7 +8,9 @@ Accepted forms:
   imports a file;
 - ``ws://host:port``: a policy server speaking the openpi websocket protocol, with the
   keys and action space of a profile (``droid``, ``libero``, ``aloha``, ``fsvla`` or a TOML
-  file: :mod:`fsvla.policies.profile`).
+  file: :mod:`fsvla.policies.profile`);
+- ``lerobot:PATH``: a LeRobot pretrained-policy folder (:mod:`fsvla.policies.lerobot`;
+  needs ``pip install lerobot``).
 """
 
 from __future__ import annotations
@@ -60,6 +62,10 @@ def load_policy(spec: str, profile: str | None = None) -> Policy:
                               f"server (--policy ws://host:port), and --policy {spec!r} is none")
     if spec in BUILTIN:
         return BUILTIN[spec]()
+    if spec.startswith("lerobot:"):
+        from .lerobot import LeRobotPolicy
+
+        return LeRobotPolicy(spec.removeprefix("lerobot:"))
     if remote:
         from .profile import load_profile
         from .remote import RemotePolicy
@@ -67,8 +73,8 @@ def load_policy(spec: str, profile: str | None = None) -> Policy:
         return RemotePolicy(spec, profile=load_profile(profile) if profile else None)
     if ":" not in spec:
         hint = did_you_mean(spec, BUILTIN)
-        raise PolicyLoadError(f"--policy {spec!r}: not a built-in policy, `module:Class` or "
-                              f"ws://host:port" + (f"; {hint}" if hint else ""))
+        raise PolicyLoadError(f"--policy {spec!r}: not a built-in policy, `module:Class`, "
+                              f"ws://host:port or lerobot:PATH" + (f"; {hint}" if hint else ""))
     module_name, _, attribute = spec.rpartition(":")
     module = _import(module_name, spec)
     factory = getattr(module, attribute, None)

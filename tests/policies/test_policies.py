@@ -91,8 +91,8 @@ def test_module_class_form(tmp_path) -> None:
 @pytest.mark.parametrize(
     ("spec", "message"),
     [
-        ("randm", "--policy 'randm': not a built-in policy, `module:Class` or ws://host:port; "
-                  "did you mean `random`?"),
+        ("randm", ("--policy 'randm': not a built-in policy, `module:Class`, ws://host:port "
+                   "or lerobot:PATH; did you mean `random`?")),
         ("no_such_module_xyz:Policy", "--policy 'no_such_module_xyz:Policy': cannot import "
                                       "no_such_module_xyz: ModuleNotFoundError"),
         ("missing.py:Policy", "--policy 'missing.py:Policy': no such file missing.py"),
