@@ -124,7 +124,12 @@ class RayBackend:
                            if hasattr(ray.exceptions, name))
         try:
             self._actors = [self._new_actor() for _ in range(self.size)]
-            for answer in ray.get([actor.ready.remote() for actor in self._actors]):
+            try:
+                answers = ray.get([actor.ready.remote() for actor in self._actors])
+            except ray.exceptions.RayError as err:  # a node died, an actor crashed, ...
+                raise BackendError(f"a Ray worker was lost while starting: {_why(err)}; run "
+                                   "the same command again") from None
+            for answer in answers:
                 self._check_ready(answer)
         except BaseException:
             self.close()

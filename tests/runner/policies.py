@@ -122,3 +122,10 @@ class StallsWhereMarked(Hold):
                 out.write(f"{self.episode.episode_id}\n")
             time.sleep(120)
         return super().act(observation)
+
+
+class DiesAtLoad:
+    """Takes its process down while it is built."""
+
+    def __init__(self) -> None:
+        os._exit(3)

@@ -112,7 +112,6 @@ class TwoNodeCluster:
     def _start(self, name: str, options: list[str], env: dict[str, str]) -> None:
         command = [self.ray, "start", *options, "--block", "--node-ip-address=127.0.0.1",
                    f"--num-cpus={self.cpus}", "--num-gpus=0", "--disable-usage-stats",
-                   f"--resources={{\"fsvla_{name}_node\": 1}}",
                    f"--dashboard-agent-listen-port={free_port()}",
                    f"--temp-dir={self.root / name}"]
         with open(self.root / f"{name}.log", "wb") as log:

@@ -1,6 +1,7 @@
 """The Ray backend scales out and survives losing a node: a run on a local two-node Ray
 cluster started with Ray's CLI, whose second node is killed mid-run, records every planned
-episode exactly once; an actor that keeps dying costs its episode after its retries.
+episode exactly once; an actor that keeps dying costs its episode after its retries; one
+lost while the run starts stops it with a message, before anything is written.
 
 Slow (a Ray cluster starts in about 10 s on two cores); CI runs it, and under ``CI=true``
 a missing ``ray`` fails instead of skipping (tests/conftest.py).
@@ -17,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from fsvla.results import ResultStore
-from fsvla.runner import execute_run, prepare_run, summarize
+from fsvla.runner import BackendError, execute_run, prepare_run, summarize
 from fsvla.runner.ray_backend import RayBackend
 
 from ..conftest import require
@@ -114,3 +115,12 @@ def test_an_actor_that_keeps_dying_costs_its_episode(ray_cli, make_run_config,
     assert "lost 2 times" in row.failure_detail and "attempt 2: ActorDiedError" in row.failure_detail
     assert row.steps == 0 and row.trace_path is None
     assert "\n" not in row.failure_detail
+
+
+def test_a_worker_lost_while_starting_is_a_backend_error(ray_cli, make_run_config,
+                                                         tmp_path) -> None:
+    config = make_run_config(policy=policy("DiesAtLoad"))
+    with pytest.raises(BackendError, match="a Ray worker was lost while starting: "
+                                           "ActorDiedError"):
+        execute_run(prepare_run(config), tmp_path / "run", RayBackend(config, 1))
+    assert not (tmp_path / "run").exists()
