@@ -216,8 +216,8 @@ class RayBackend:
             self.reruns.append(Rerun(flight.spec.episode_id, len(losses), why))
             return None
         told = "; ".join(f"attempt {n}: {text}" for n, text in enumerate(losses, start=1))
-        return _lost(f"the Ray worker running the episode was lost {len(losses)} times, the "
-                     f"steps it ran with it ({told})", flight.started, flight.since)
+        return _lost(f"the Ray worker running the episode was lost {len(losses)} times, with "
+                     f"the steps it had run ({told})", flight.started, flight.since)
 
     def _replace(self, run: _Run, index: int) -> None:
         """Start a new actor in slot ``index`` in place of a lost one."""
