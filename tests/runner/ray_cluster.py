@@ -50,7 +50,8 @@ class TwoNodeCluster:
         self.ray = ray
         self.cpus = cpus
         self.second_env = dict(second_env or {})
-        self.root = Path(tempfile.mkdtemp(prefix="fsvla-ray-"))
+        short = "/tmp" if os.path.isdir("/tmp") else None  # not a long $TMPDIR
+        self.root = Path(tempfile.mkdtemp(prefix="fsvla-ray-", dir=short))
         self.port = free_port()
         self.env = {key: value for key, value in os.environ.items()
                     if not key.startswith("RAY_")}
