@@ -151,6 +151,12 @@ class SceneState(Protocol):
         """A new kinematic model of ``arm`` (callers keep it: it may be costly to make)."""
         ...
 
+    def contact_force(self, arm: str, links: Sequence[str], other: str | None = None) -> float:
+        """A force sensor on the hand: the largest net contact force (N) on one of ``arm``'s
+        robot ``links`` at the last physics substep, from the scene's bodies (only from
+        the body ``other`` when given); contacts between robot links are left out."""
+        ...
+
 
 # --- monitoring --------------------------------------------------------------------------
 

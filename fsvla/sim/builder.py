@@ -176,6 +176,27 @@ class BuiltScene:
     def arm_model(self, arm: str) -> ArmKinematics:
         return ArmKinematics(self.robot.arm(arm))
 
+    def contact_force(self, arm: str, links: Sequence[str], other: str | None = None) -> float:
+        mine = {link: link.name for link in self.robot.arm(arm).articulation.links
+                if link.name in links}
+        robot = {link for articulation in self.robot.articulations.values()
+                 for link in articulation.links}
+        source: set[Any] | None = None
+        if other in self.bodies:
+            source = {_rigid_component(self.bodies[other])}
+        elif other is not None:
+            source = set(self.articulations[other].links)
+        totals: dict[str, NDArray[np.float64]] = {}
+        for contact in self.scene.get_contacts():
+            b0, b1 = contact.bodies
+            for link, far, sign in ((b0, b1, 1.0), (b1, b0, -1.0)):  # impulses act on b0
+                if link in mine and far not in robot and (source is None or far in source):
+                    total = totals.setdefault(mine[link], np.zeros(3))
+                    for point in contact.points:
+                        total += sign * np.asarray(point.impulse, dtype=np.float64)
+        inv_dt = 1.0 / self.spec.physics.timestep
+        return max((float(np.linalg.norm(t)) * inv_dt for t in totals.values()), default=0.0)
+
     # --- fsvla.world.MonitoredScene: what the safety monitor reads -------------------------
     def frames(self) -> list[str]:
         return list(self._components())

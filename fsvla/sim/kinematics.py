@@ -28,6 +28,22 @@ from fsvla.world import IKResult
 from .robot import LoadedArm
 
 
+def _primitive_corners(shape: Any) -> NDArray[np.float64] | None:
+    """The 8 corners of a box, sphere, capsule or cylinder collision shape's bounding box
+    in its own frame (SAPIEN's capsules and cylinders lie along x); None for others."""
+    if hasattr(shape, "half_size"):
+        half = np.asarray(shape.half_size, dtype=np.float64)
+    elif hasattr(shape, "half_length"):
+        r = float(shape.radius)
+        half = np.array([float(shape.half_length) + r, r, r])
+    elif hasattr(shape, "radius"):
+        half = np.full(3, float(shape.radius))
+    else:
+        return None
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+    return signs * half
+
+
 class ArmKinematics:
     """FK/IK of one arm; other joints of its articulation stay where they are."""
 
@@ -65,9 +81,12 @@ class ArmKinematics:
         """The vertices of a link's convex collision pieces, in the link's frame."""
         parts = []
         for shape in self.arm.articulation.get_links()[link].collision_shapes:
-            if not hasattr(shape, "get_vertices"):
-                continue
-            v = np.asarray(shape.get_vertices(), dtype=np.float64) * np.asarray(shape.scale)
+            if hasattr(shape, "get_vertices"):
+                v = np.asarray(shape.get_vertices(), dtype=np.float64) * np.asarray(shape.scale)
+            else:  # a primitive: the corners of its box (an over-estimate, like the hulls)
+                v = _primitive_corners(shape)
+                if v is None:
+                    continue
             pose = shape.local_pose
             parts.append(transform_points(v, pose.p, pose.q))
         return np.concatenate(parts) if parts else None
