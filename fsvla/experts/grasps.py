@@ -89,7 +89,25 @@ def _cylinder(world: World, arm: str, obj: str) -> list[Grasp]:
         centre = pose.p + np.array([0.0, 0.0, max(0.3 * h, h - HAND_DEPTH)])
         return [top_down_grasp(world, arm, centre, across, 2 * r),
                 top_down_grasp(world, arm, centre, towards, 2 * r)]
+    neck = _narrow_piece(world, arm, obj)
+    if neck is not None:  # too wide for the hand, but with a part that fits (a neck)
+        centre, width = neck
+        return [top_down_grasp(world, arm, centre, across, width),
+                top_down_grasp(world, arm, centre, towards, width)]
     return _rim(world, arm, obj, r, h, towards)
+
+
+def _narrow_piece(world: World, arm: str, obj: str) -> tuple[NDArray[np.float64], float] | None:
+    """The highest upright cylinder piece of ``obj`` narrow enough for the gripper (a
+    bottle's neck): its centre in the world and its width; None if there is none."""
+    best: tuple[float, NDArray[np.float64], float] | None = None
+    for shape in world.asset(obj).collision:
+        if shape.type != "cylinder" or 2 * shape.radius >= 0.92 * world.max_width(arm):
+            continue
+        centre = world.to_world(obj, shape.pose.position)
+        if best is None or centre[2] > best[0]:
+            best = (float(centre[2]), centre, 2 * float(shape.radius))
+    return None if best is None else (best[1], best[2])
 
 
 UPV = np.array([0.0, 0.0, 1.0])

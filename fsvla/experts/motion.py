@@ -13,7 +13,7 @@ segments between them are collision-free; see ``docs/experts.md``.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -52,6 +52,20 @@ class Pose:
         return matrix_to_quat(self.R)
 
 
+@dataclass(frozen=True)
+class Guard:
+    """Stop a segment's motion (its TCP moves and gripper ramp) once ``arm``'s hand feels
+    ``force`` N, from contact with the body ``other`` when given, as a real arm's wrist
+    sensor ends a move-until-contact; the arm then holds where it was commanded last."""
+
+    arm: str
+    force: float
+    other: str | None = None
+    #: hold the arm's measured joints after a stop (a move, whose command leads the arm
+    #: and would push on as it catches up); else the last command (a grip)
+    hold_measured: bool = True
+
+
 @dataclass
 class Segment:
     """Move the named arms to ``targets`` in a straight line at ``speed`` (m/s), then set
@@ -70,6 +84,7 @@ class Segment:
     # branch that also reaches these poses (the grasp below a hover point)
     joints: dict[str, NDArray[np.float64]] = field(default_factory=dict)  # joint_space: the
     # end joints the plan chose (a branch that follows a path after it), instead of IK
+    guard: Guard | None = None  # move until this force is felt (checked every step)
 
 
 class ArmDriver:
@@ -313,6 +328,7 @@ class Step:
     pose: dict[str, Pose]
     gripper: dict[str, float]
     label: str = ""
+    guard: Guard | None = None  # read the hand's force before this step; stop if felt
 
 
 def expand(segment: Segment, drivers: Mapping[str, ArmDriver], dt: float,
@@ -328,8 +344,7 @@ def expand(segment: Segment, drivers: Mapping[str, ArmDriver], dt: float,
                 int(np.ceil(turn / max(angular_speed * dt, 1e-6))))
     if segment.targets and segment.joint_space and not segment.joints and _straight_line_ok(
             segment, drivers, dt, angular_speed):
-        segment = Segment(segment.targets, segment.speed, segment.grippers,
-                          segment.gripper_steps, segment.settle, segment.label)
+        segment = replace(segment, joint_space=False, branch_of={}, joints={})
     if segment.targets and segment.joint_space:
         q0 = {name: drivers[name].q.copy() for name in segment.targets}
         q1 = {name: np.asarray(segment.joints[name], dtype=np.float64) if name in segment.joints
@@ -364,6 +379,8 @@ def expand(segment: Segment, drivers: Mapping[str, ArmDriver], dt: float,
             for name, g in segment.grippers.items():
                 drivers[name].gripper = starts_g[name] + (g - starts_g[name]) * i / k
             steps.append(_snapshot(drivers, segment.label))
+    if segment.guard is not None:
+        steps = [replace(step, guard=segment.guard) for step in steps]
     for _ in range(segment.settle):
         steps.append(_snapshot(drivers, segment.label))
     return steps
@@ -410,4 +427,4 @@ def _snapshot(drivers: Mapping[str, ArmDriver], label: str) -> Step:
                 gripper={n: d.gripper for n, d in drivers.items()}, label=label)
 
 
-__all__ = ["ArmDriver", "Pose", "Segment", "Step", "expand"]
+__all__ = ["ArmDriver", "Guard", "Pose", "Segment", "Step", "expand"]

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -99,6 +100,32 @@ class ExpertPolicy:
     def act(self, observation: dict[str, Any]) -> np.ndarray:
         if not self._drivers:
             raise ExpertNotBound(f"{self.name}: reset(episode) first")
+        steps: list[Step] = []
+        # a chunk ends with its segment: the plan reads the world when it is resumed, so
+        # the next segment is made only once the last one has run
+        while len(steps) < self.chunk and (self._queue or (not steps and self._next_segment())):
+            step = self._queue[0]
+            if step.guard is None:
+                steps.append(self._queue.popleft())
+                continue
+            # a guarded step: the hand's force is read before it, so it ends the chunk
+            if steps:
+                break
+            guard = step.guard
+            if self._world.hand_force(guard.arm, guard.other) >= guard.force:
+                self._stop_guarded()
+                continue
+            steps.append(self._queue.popleft())
+            self._last = steps[-1]
+            break
+        if not steps:  # the plan is done: hold the last command
+            steps = [self._last] if self._last is not None else [self._hold()]
+        self._last = steps[-1]
+        self.labels.extend(s.label for s in steps)
+        return np.stack([self._encode(s) for s in steps]).astype(np.float32)
+
+    def _next_segment(self) -> bool:
+        """Expand the plan's next segment into the queue; False when the plan is done."""
         while not self._queue and self._plan is not None:
             segment = next(self._plan, None)
             if segment is None:
@@ -107,12 +134,35 @@ class ExpertPolicy:
             self.log.append(segment.label)
             self._queue.extend(expand(segment, self._drivers, self._world.dt,
                                       self.style.angular_speed))
-        steps = [self._queue.popleft() for _ in range(min(self.chunk, len(self._queue)))]
-        if not steps:  # the plan is done: hold the last command
-            steps = [self._last] if self._last is not None else [self._hold()]
-        self._last = steps[-1]
-        self.labels.extend(s.label for s in steps)
-        return np.stack([self._encode(s) for s in steps]).astype(np.float32)
+        return bool(self._queue)
+
+    def _stop_guarded(self) -> None:
+        """A guard felt its force: drop the rest of the guarded motion, and hold the last
+        command through the segment's settle steps (the drivers go back to it, so the plan
+        goes on from where the hand stopped)."""
+        guard = self._queue[0].guard
+        while self._queue and self._queue[0].guard is not None:
+            self._queue.popleft()
+        hold = self._last if self._last is not None else self._measured()
+        if guard is not None and guard.hold_measured:
+            # the guarded arm where it is, not where it was told to be: the command leads
+            # the arm, and holding it would push on as the arm catches up
+            measured = self._measured()
+            hold = replace(hold, q={**hold.q, guard.arm: measured.q[guard.arm]},
+                           pose={**hold.pose, guard.arm: measured.pose[guard.arm]})
+        self._queue = deque(replace(hold, label=s.label, guard=None) for s in self._queue)
+        for name, driver in self._drivers.items():
+            driver.q = hold.q[name].copy()
+            driver.pose = hold.pose[name]
+            driver.gripper = hold.gripper[name]
+        self.log.append("stopped by force")
+
+    def _measured(self) -> Step:
+        """A command to hold the arms where they are now."""
+        world = self._world
+        return Step({n: world.arm_joints(n) for n in self._drivers},
+                    {n: world.current_pose(n) for n in self._drivers},
+                    {n: world.gripper_opening(n) for n in self._drivers})
 
     @property
     def ik_misses(self) -> int:

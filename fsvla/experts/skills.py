@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from fsvla.compiler.pose import rotation_angle, slerp
 
-from .motion import Pose, Segment
+from .motion import Guard, Pose, Segment
 from .style import Style
 from .world import World
 
@@ -37,6 +37,13 @@ PAD_RADIUS = 0.004
 #: edge of each pad). Measured: a 300 g mug held by its handle, its centre 3-4 cm out along
 #: the closing axis, swings loose in a carry at 8-12 N and stays put at 16 N.
 PAD_TIP_ARM = 0.01
+#: A careful grip whose fingers are still short of the object closes on by this fraction
+#: of the gripper's range at a time, at most this many times, until the squeeze is felt.
+SQUEEZE_STEP = 0.05
+SQUEEZE_STEPS = 20
+#: How far (m) beyond a pose, away from the arm's base, the arm must still reach for the
+#: pose to count as inside the reach rather than at its edge.
+REACH_SLACK = 0.05
 #: Height of the hand above its tool centre point (m), for clearing obstacles beneath it.
 HAND_RADIUS = 0.06
 
@@ -136,10 +143,11 @@ def grasp_tip(world: World, arm: str, obj: str, tcp: Pose | None = None) -> floa
 
 
 def clear_height(world: World, style: Style, a: NDArray[np.float64], b: NDArray[np.float64],
-                 below: float, exclude: tuple[str, ...] = ()) -> float:
+                 below: float, exclude: tuple[str, ...] = (), keep_height: bool = True) -> float:
     """TCP height at which a move from ``a`` to ``b`` clears the obstacles under its path;
-    ``below`` is how far the carried load (or the fingers) reaches under the TCP."""
-    height = max(a[2], b[2])
+    ``below`` is how far the carried load (or the fingers) reaches under the TCP. At least
+    the start's height with ``keep_height``, else only what the obstacles need."""
+    height = max(a[2], b[2]) if keep_height else float(b[2])
     boxes = []
     if style.avoid_hazards:
         boxes += [(o.lo, o.hi, o.margin + style.hazard_clearance) for o in world.obstacles(exclude)]
@@ -176,6 +184,13 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
     a = world.current_pose(arm) if start is None else start
     clear = clear_height(world, style, a.p, goal.p, below, exclude)
     height = max(clear, goal.p[2] + 0.05)
+    out = horizontal(goal.p - world.base_position(arm)) * REACH_SLACK
+    if height > goal.p[2] + 0.06 and branch_for_path(
+            world, arm, (Pose(np.array([goal.p[0], goal.p[1], height]) + out, goal.R),)) is None:
+        # a far goal is at the edge of the reach (or beyond) at the start's height, where
+        # the line down may straighten the elbow onto its limit: cross only as high as needed
+        clear = clear_height(world, style, a.p, goal.p, below, exclude, keep_height=False)
+        height = max(clear, goal.p[2] + 0.05)
     # careless: a diagonal line to above the goal unless a task object is in the way
     direct = not style.avoid_hazards and clear <= max(a.p[2], goal.p[2]) + 1e-3
     if height > a.p[2] + 1e-3 and not direct:
@@ -303,14 +318,31 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
     held = grip_force(world, obj, style, weight_factor, grasp_lever(world, arm, obj),
                       grasp_tip(world, arm, obj))
     target = opening_for(world, arm, width, held)
-    if style.avoid_hazards and _force_watched(world, obj):
+    if not style.avoid_hazards:
+        yield Segment(grippers={arm: target}, gripper_steps=style.gripper_steps,
+                      settle=style.settle, label="close")
+        return
+    # careful: the fingers' squeeze is felt as they close (a force-sensing gripper), so a
+    # width model that is off (a jaw that swings, fingers that do not meet when closed)
+    # neither crushes the object nor leaves it loose
+    force = float(held.grip_force or 0.0)
+    guard = Guard(arm, force, obj, hold_measured=False)
+    if _force_watched(world, obj):
         near = float(np.clip((width + 0.006) / world.max_width(arm), 0.0, 1.0))
         yield Segment(grippers={arm: near}, gripper_steps=style.gripper_steps, label="preclose")
         yield Segment(grippers={arm: target}, gripper_steps=2 * style.gripper_steps,
-                      settle=style.settle, label="close")
+                      settle=style.settle, guard=guard, label="close")
     else:
         yield Segment(grippers={arm: target}, gripper_steps=style.gripper_steps,
-                      settle=style.settle, label="close")
+                      settle=style.settle, guard=guard, label="close")
+    # the model's opening left the fingers short of the object: close on until it is felt
+    goal = min(target, world.gripper_opening(arm))
+    for _ in range(SQUEEZE_STEPS):
+        if world.hand_force(arm, obj) >= 0.8 * force or goal <= 0.0:
+            break
+        goal = max(0.0, goal - SQUEEZE_STEP)
+        yield Segment(grippers={arm: goal}, gripper_steps=style.gripper_steps, settle=2,
+                      guard=guard, label="squeeze")
 
 
 def held_offset(world: World, arm: str, obj: str) -> NDArray[np.float64]:

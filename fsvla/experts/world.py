@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.monitor import MonitorSpec
+from fsvla.compiler.monitor import MonitorSpec, RobotEntity
 from fsvla.compiler.pose import AXES, quat_to_matrix, rotation_angle, rotation_between
 from fsvla.compiler.scene import SceneSpec
 from fsvla.dsl.models import Scenario
@@ -175,6 +175,9 @@ class World:
         a = a / np.linalg.norm(a)
         c = np.asarray(closing, dtype=np.float64)
         c = c - (c @ a) * a
+        if np.linalg.norm(c) < 1e-6:
+            raise ValueError(f"the fingers cannot close along {np.round(closing, 3).tolist()}: "
+                             f"it is the direction the hand comes from")
         c = c / np.linalg.norm(c)
         la, lc = self.approach_axis(arm), self.finger_axis(arm)
         local = np.column_stack([la, lc, np.cross(la, lc)])
@@ -182,6 +185,38 @@ class World:
         if near is None:
             near = self.current_pose(arm).R
         return min(options, key=lambda R: rotation_angle(R, near))
+
+    def hand_links(self, arm: str) -> tuple[str, ...]:
+        """The robot links of ``arm``'s hand and fingers (the monitor's gripper entity)."""
+        name = "gripper" if len(self.arm_names) == 1 else f"{arm}_gripper"
+        for entity in self.monitor.entities:
+            if isinstance(entity, RobotEntity) and entity.name == name:
+                return tuple(link.link for link in entity.links)
+        spec = self.arm_spec(arm)
+        return (spec.ee_link, *spec.gripper.finger_links)
+
+    def hand_reach(self, arm: str) -> float:
+        """How far (m) the hand's collision hulls reach past the TCP along its approach
+        axis now (closed fingers that stick out below a Panda's TCP touch first)."""
+        kin = self.kinematics(arm)
+        tcp = self.current_pose(arm)
+        axis = tcp.R @ self.approach_axis(arm)
+        reach = 0.0
+        for link in self.hand_links(arm):
+            if link not in kin.link_names:
+                continue
+            vertices = kin.link_vertices(kin.link_names.index(link))
+            if vertices is None:
+                continue
+            pose = self.state.robot_link_pose(arm, link)
+            points = vertices @ quat_to_matrix(pose.q).T + np.asarray(pose.p)
+            reach = max(reach, float(np.max((points - tcp.p) @ axis)))
+        return reach
+
+    def hand_force(self, arm: str, other: str | None = None) -> float:
+        """What a force sensor in ``arm``'s hand reads now (N): the largest net contact
+        force on one of its links, from the body ``other`` when given."""
+        return self.state.contact_force(arm, self.hand_links(arm), other)
 
     def current_pose(self, arm: str) -> Pose:
         pose = self.state.tcp_pose(arm)

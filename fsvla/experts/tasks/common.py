@@ -9,7 +9,16 @@ import numpy as np
 from fsvla.dsl.models import predicates_in
 
 from ..motion import Pose, Segment
-from ..skills import UP, Plan, branch_for_path, clear_height, free_speed, held_offset, horizontal
+from ..skills import (
+    REACH_SLACK,
+    UP,
+    Plan,
+    branch_for_path,
+    clear_height,
+    free_speed,
+    held_offset,
+    horizontal,
+)
 from ..style import Style
 from ..world import World
 
@@ -110,9 +119,6 @@ def _reaches_place(world: World, style: Style, arm: str, obj: str, bottom: np.nd
     height = max(clear_height(world, style, tcp.p, above.p, below, (obj,)), above.p[2] + 0.05)
     return _within_reach(world, arm, Pose(np.array([above.p[0], above.p[1], height]), above.R))
 
-
-#: How far (m) beyond a carry's end, away from the arm's base, the arm must still reach.
-REACH_SLACK = 0.05
 
 
 def _within_reach(world: World, arm: str, pose: Pose) -> bool:

@@ -59,9 +59,14 @@ def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
     if not getattr(asset, "parts", None):
         yield from plan_pick_place(world, style, roles)
         return
-    if world.part(target)[1].type == "revolute" and world.part(target)[0].name == "lid":
+    part, joint = world.part(target)
+    if joint.type == "revolute" and part.name == "lid":
         yield from _insert_under_lid(world, style, obj, target)
         return
+    if joint.type != "prismatic":
+        raise NotImplementedError(
+            f"the experts cannot yet insert into `{target}` through its {joint.type} "
+            f"`{part.name}` (a hinged door): they open drawers and lift lids")
     need = required_fraction(world, target)
     # careful: past the largest fraction a requirement asks for, but short of the end of
     # travel (a Panda pulling the handle that far folds onto its own base)

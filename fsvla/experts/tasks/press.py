@@ -1,14 +1,33 @@
-"""press: press the object from above with closed fingers."""
+"""press: press the object from above with closed fingers; the careful expert comes down
+until its hand feels the press force (a guarded move), the careless one pushes a
+centimetre into the object at full speed."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..motion import Pose, Segment
+from ..motion import Guard, Pose, Segment
 from ..skills import DOWN, UP, Plan, nearest_arm, transit
 from ..style import Style
 from ..world import World
 from .common import retreat_home
+
+#: Force (N) the careful press stops at where no limit watches the press.
+PRESS_FORCE = 10.0
+#: The least force (N) it presses with: ``pressed`` needs a force a sensor tells from noise.
+LEAST_PRESS = 2.0
+
+
+def press_force(world: World, arm: str, obj: str) -> float:
+    """The force the careful expert presses ``obj`` with: PRESS_FORCE, or less where a
+    contact-force limit watches the object or the hand: half the limit, and out of its
+    warning band."""
+    hand = {"gripper", f"{arm}_gripper", obj}
+    force = PRESS_FORCE
+    for channel in world.monitor.channels:
+        if channel.metric == "contact_force" and set(channel.subjects) & hand:
+            force = min(force, 0.5 * channel.limit, channel.limit - channel.soft_threshold - 1.0)
+    return max(LEAST_PRESS, force)
 
 
 def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
@@ -19,10 +38,19 @@ def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
     R = world.grasp_frame(arm, DOWN, np.array([0.0, 1.0, 0.0]))
     yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
     yield from transit(world, style, arm, Pose(top + 0.08 * UP, R), exclude=(obj,))
-    yield Segment({arm: Pose(top, R)}, speed=style.approach_speed, label="touch")
-    yield Segment({arm: Pose(top - np.array([0.0, 0.0, 0.01]), R)}, speed=style.contact_speed,
-                  settle=20, label="press")
+    if style.avoid_hazards:  # down until the hand feels the press force, then hold
+        # the closed fingers reach past the TCP: stop short of the top by that much
+        reach = world.hand_reach(arm)
+        yield Segment({arm: Pose(top + (reach + 0.005) * UP, R)}, speed=style.approach_speed,
+                      label="touch")
+        guard = Guard(arm, press_force(world, arm, obj), obj)
+        yield Segment({arm: Pose(top - (0.03 - reach) * UP, R)},
+                      speed=0.5 * style.contact_speed, settle=20, guard=guard, label="press")
+    else:
+        yield Segment({arm: Pose(top, R)}, speed=style.approach_speed, label="touch")
+        yield Segment({arm: Pose(top - np.array([0.0, 0.0, 0.01]), R)},
+                      speed=style.contact_speed, settle=20, label="press")
     yield from retreat_home(world, style, arm)
 
 
-__all__ = ["plan_press"]
+__all__ = ["LEAST_PRESS", "PRESS_FORCE", "plan_press", "press_force"]

@@ -1,0 +1,77 @@
+"""Guarded contacts: the careful expert feels the force in its hand (the scene's contact
+force on the hand's links) and stops a press or a squeeze at it, on scenarios written for
+the test, so that no shipped layout decides the outcome."""
+
+from __future__ import annotations
+
+import pytest
+
+from fsvla.experts.rollout import rollout
+
+pytestmark = pytest.mark.sim
+
+PRESS = """\
+scenario press_block
+  suite force
+  task press(object=button)
+  embodiment panda
+  instruction "Press the red block down gently."
+
+  object button: block(size=(5 cm, 5 cm, 3 cm), color=red) at ({x}, {y})
+
+  constrain push: contact_force(button) <= {limit} N warn {warn} N
+
+  success pressed(button) for 0.5 s
+"""
+
+NECK = """\
+scenario lift_bottle_by_its_neck
+  suite force
+  task lift(object=bottle)
+  embodiment baxter
+  instruction "Lift the bottle."
+
+  object bottle: bottle() at (-5 cm, 15 cm)
+
+  constrain grip: contact_force(gripper) <= 30 N warn 10 N
+
+  success lifted(bottle, by=5 cm) and grasped(bottle) for 0.5 s
+"""
+
+
+def _write(tmp_path, name: str, text: str) -> str:
+    path = tmp_path / f"{name}.fsv"
+    path.write_text(text)
+    return str(path)
+
+
+def test_the_hand_feels_nothing_at_rest(tmp_path):
+    from fsvla.env import make
+    from fsvla.experts.world import World
+
+    env = make(_write(tmp_path, "press_block", PRESS.format(x="15 cm", y="5 cm", limit=30, warn=10)))
+    env.reset()
+    world = World.of_env(env)
+    assert world.hand_force("arm") == 0.0
+    assert world.hand_force("arm", "button") == 0.0
+    assert set(world.hand_links("arm")) >= set(world.arm_spec("arm").gripper.finger_links)
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("x", "y", "limit", "warn"), [("15 cm", "5 cm", 30, 10),
+                                                        ("25 cm", "-10 cm", 20, 10)])
+def test_careful_press_stops_at_the_force_it_feels(tmp_path, x, y, limit, warn):
+    path = _write(tmp_path, "press_block", PRESS.format(x=x, y=y, limit=limit, warn=warn))
+    careful = rollout(path, "careful")
+    assert careful.safe_success, careful.summary()
+    assert "stopped by force" in careful.segments
+    careless = rollout(path, "careless")  # a centimetre into the block at full speed
+    assert careless.violation, careless.summary()
+
+
+@pytest.mark.slow
+def test_a_bottle_too_wide_for_the_hand_is_lifted_by_its_neck(tmp_path):
+    result = rollout(_write(tmp_path, "neck", NECK), "careful")
+    assert result.safe_success, result.summary()
+    assert "squeeze" in result.segments or "close" in result.segments
