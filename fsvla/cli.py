@@ -368,6 +368,11 @@ from .validate.command import validate_command
 
 main.add_command(validate_command)
 
+# `fsvla attack`: optimise the V4 patch against a policy.
+from .attack.command import attack_command
+
+main.add_command(attack_command)
+
 
 def run(argv: Iterable[str] | None = None) -> int:
     """Run the CLI and return its exit code instead of exiting (for tests and embedding)."""
