@@ -51,18 +51,27 @@ def attack_command(scenario: str, policy: str, out: Path, target: str | None, si
     from fsvla.policies import PolicyLoadError
     from fsvla.policies.registry import load_policy
 
-    from .gradient import TorchUnavailable
+    from .gradient import TorchUnavailable, is_differentiable, require_torch
     from .optimise import optimise_patch, write_patch
     from .views import AttackInputError, attack_views
 
     try:
         loaded = load_policy(policy)
+        if method == "gradient":
+            require_torch()
+            if not is_differentiable(loaded):
+                raise AttackInputError(f"--method gradient: the policy {policy} offers no "
+                                       "torch_act(observation, images) to differentiate "
+                                       "(docs/attack.md); use --method search")
         patch, views = attack_views(scenario, target=target, size=size, layouts=layouts,
                                     transforms=transforms, seed=seed, embodiment=embodiment,
                                     resolution=resolution)
         image, numbers = optimise_patch(loaded, views, method=method,  # type: ignore[arg-type]
                                         budget=budget, seed=seed, pixels=pixels)
-    except (AttackInputError, PolicyLoadError, ScenarioLoadError, TorchUnavailable) as problem:
+    except TorchUnavailable as problem:  # only --method gradient asks for it
+        _fail(f"--method gradient: {problem}", 2)
+        return
+    except (AttackInputError, PolicyLoadError, ScenarioLoadError) as problem:
         _fail(str(problem), 2)
         return
     except ValueError as problem:  # a bad --resolution, --embodiment, --method gradient

@@ -41,7 +41,8 @@ def is_differentiable(policy: object) -> bool:
     return isinstance(policy, DifferentiablePolicy)
 
 
-def _torch() -> Any:
+def require_torch() -> Any:
+    """The ``torch`` module; :class:`TorchUnavailable` saying how to install it."""
     try:
         import torch
     except ImportError as err:
@@ -54,7 +55,7 @@ def gradient_attack(policy: DifferentiablePolicy, views: Sequence[View],
                     lr: float = 0.1) -> NDArray[np.float64]:
     """The best patch (S × S × 3 in [0, 1]) of ``steps`` Adam steps from ``initial`` (as
     the differentiable objective rated it)."""
-    torch = _torch()
+    torch = require_torch()
     torch.manual_seed(int(rng.integers(2**31)))
     start = np.clip(np.asarray(initial, dtype=np.float64), 1e-3, 1 - 1e-3)
     logits = torch.tensor(np.log(start / (1 - start)), dtype=torch.float32, requires_grad=True)
@@ -112,4 +113,4 @@ def _composite(torch: Any, frames: dict[str, Any], places: dict[str, tuple[Any, 
 
 
 __all__ = ["INSTALL", "DifferentiablePolicy", "TorchUnavailable", "gradient_attack",
-           "is_differentiable"]
+           "is_differentiable", "require_torch"]

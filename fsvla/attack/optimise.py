@@ -23,7 +23,7 @@ from fsvla.variation.patch import patch_pixels
 
 from .gradient import gradient_attack, is_differentiable
 from .objective import Objective
-from .search import square_search, stripes
+from .search import square_search
 from .views import View
 
 Method = Literal["auto", "gradient", "search"]
@@ -50,7 +50,8 @@ def choose_method(policy: object, method: Method) -> Literal["gradient", "search
 def optimise_patch(policy: Policy, views: Sequence[View], *, method: Method, budget: int,
                    seed: int, pixels: int = ATTACK_PIXELS) -> tuple[NDArray[np.float64], dict[str, Any]]:
     """The optimised patch (``pixels`` square, values in [0, 1]) and the numbers of the
-    attack (objective before, after, the random baseline, the method, the queries).
+    attack (objective before, after, the random baseline, the method, the queries). The
+    search starts from the best random patch, the gradient attack from grey noise.
     ``budget`` counts objective evaluations for the search (each asks the policy once per
     view) and Adam steps for the gradient attack."""
     chosen = choose_method(policy, method)
@@ -61,9 +62,10 @@ def optimise_patch(policy: Policy, views: Sequence[View], *, method: Method, bud
     objective = Objective(policy, views)
     baseline = [objective(patch_pixels(seed + 1 + i, pixels) / 255.0)
                 for i in range(BASELINE_PATCHES)]
-    if chosen == "search":
-        initial = stripes(pixels, rng)
-        before = objective(initial)
+    if chosen == "search":  # from the best random patch: its value is already known
+        best = int(np.argmax(baseline))
+        initial = patch_pixels(seed + 1 + best, pixels) / 255.0
+        before = baseline[best]
         patch = square_search(objective, initial, budget, rng).patch
     else:
         initial = rng.uniform(0.25, 0.75, size=(pixels, pixels, 3))

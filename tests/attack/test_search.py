@@ -4,6 +4,8 @@ deterministic for a seed."""
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 
@@ -36,7 +38,7 @@ def test_the_search_beats_random_patches_twice_over() -> None:
     result = square_search(objective, stripes(PIXELS, rng), 300, rng)
     assert len(calls) == 300 and len(result.history) == 300
     assert result.value >= 2 * random_mean
-    assert all(b >= a for a, b in zip(result.history, result.history[1:]))
+    assert all(b >= a for a, b in pairwise(result.history))
     assert result.patch.min() >= 0 and result.patch.max() <= 1
 
 
@@ -49,7 +51,7 @@ def test_the_search_is_deterministic_for_a_seed() -> None:
 def test_the_square_shrinks_over_the_budget() -> None:
     shares = [square_share(step, 1000) for step in range(1000)]
     assert shares[0] == pytest.approx(0.3) and shares[-1] < shares[0] / 100
-    assert all(b <= a for a, b in zip(shares, shares[1:]))
+    assert all(b <= a for a, b in pairwise(shares))
 
 
 def test_a_budget_below_one_is_refused() -> None:
