@@ -24,8 +24,10 @@ from typing import Any
 
 import numpy as np
 
+from fsvla.compiler.pose import quat_to_matrix
+
 from .clearance import ArmClearance
-from .motion import ArmDriver, Segment, Step, expand
+from .motion import ArmDriver, Pose, Segment, Step, expand
 from .style import CAREFUL, CARELESS, STYLES, Style
 from .tasks import TASK_PLANS
 from .world import World
@@ -147,9 +149,11 @@ class ExpertPolicy:
         if guard is not None and guard.hold_measured:
             # the guarded arm where it is, not where it was told to be: the command leads
             # the arm, and holding it would push on as the arm catches up
-            measured = self._measured()
-            hold = replace(hold, q={**hold.q, guard.arm: measured.q[guard.arm]},
-                           pose={**hold.pose, guard.arm: measured.pose[guard.arm]})
+            arm, measured = guard.arm, self._measured()
+            q = measured.q[arm] + guard.keep_lead * (hold.q[arm] - measured.q[arm])
+            tcp = self._drivers[arm].kin.tcp_pose(q)
+            hold = replace(hold, q={**hold.q, arm: q},
+                           pose={**hold.pose, arm: Pose.of(tcp.p, quat_to_matrix(tcp.q))})
         self._queue = deque(replace(hold, label=s.label, guard=None) for s in self._queue)
         for name, driver in self._drivers.items():
             driver.q = hold.q[name].copy()

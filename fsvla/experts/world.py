@@ -142,6 +142,13 @@ class World:
         base = self.state.robot_link_pose(arm, self.arm_spec(arm).base_link)
         return np.asarray(base.p, dtype=np.float64)
 
+    def home_position(self, arm: str) -> NDArray[np.float64]:
+        """Where the arm's TCP is at its home joints: the middle of where it works (an arm
+        mounted behind the table, as Baxter's, reaches forward from its base)."""
+        kin = self.kinematics(arm)
+        return np.asarray(kin.tcp_pose(np.asarray(kin.spec.home, dtype=np.float64)).p,
+                          dtype=np.float64)
+
     def finger_axis(self, arm: str) -> NDArray[np.float64]:
         """The direction the fingers close along, in the TCP frame (unit)."""
         if arm not in self._finger_axis:

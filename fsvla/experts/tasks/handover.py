@@ -32,6 +32,21 @@ LONG_ENOUGH = 0.15
 END_GRASP = 0.025
 
 
+#: How far (m) the hands meet in front of their home positions when the arms reach the
+#: same way (side by side, as Baxter's): out where the arms' links stay apart.
+MEET_AHEAD = 0.15
+
+
+def meeting_point(world: World, giver: str, taker: str) -> np.ndarray:
+    """Where the hands meet: halfway between the arms' home TCPs, moved out along the way
+    both arms reach (arms facing each other reach opposite ways: halfway between them; arms
+    side by side behind the table: in front of the robot, where their links stay apart)."""
+    homes = [world.home_position(arm) for arm in (giver, taker)]
+    ahead = np.mean([horizontal(h - world.base_position(arm))
+                     for arm, h in zip((giver, taker), homes)], axis=0)
+    return 0.5 * (homes[0] + homes[1]) + MEET_AHEAD * ahead
+
+
 def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
     """The arm nearer the object picks it, brings it over the middle of the table; the other
     arm takes it from the side, the first lets go and backs off, the second puts it on the
@@ -47,7 +62,7 @@ def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
     yield from pick(world, style, giver, obj, grasp)
     lo, hi = world.bounds(obj)
     size = hi - lo
-    mid = 0.5 * (world.base_position(giver) + world.base_position(taker))
+    mid = meeting_point(world, giver, taker)
     height = max([o.hi[2] + o.margin + style.hazard_clearance for o in world.obstacles((obj,))]
                  + [0.1]) + 0.12
     centre = np.array([mid[0], mid[1], height])
@@ -56,7 +71,7 @@ def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
     giver_goal = Pose(centre + np.array([0.0, 0.0, max(offset[2], 0.3 * size[2] / 2 + 0.008)]),
                       tcp.R)
     yield from transit(world, style, giver, giver_goal, below=0.05, exclude=(obj,))
-    towards = horizontal(centre - world.base_position(taker))
+    towards = horizontal(centre - world.home_position(taker))
     closing = tcp.R @ world.finger_axis(giver)
     R = world.grasp_frame(taker, towards, closing)
     take = Pose(centre - np.array([0.0, 0.0, 0.3 * size[2]]) - towards * 0.004, R)
@@ -98,7 +113,7 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
     width = 2 * float(half[1 - axis])
     grasp = top_down_grasp(world, giver, centre + side * reach * along + lift, across, width)
     yield from pick(world, style, giver, obj, grasp)
-    mid = 0.5 * (world.base_position(giver) + world.base_position(taker))
+    mid = meeting_point(world, giver, taker)
     height = max([o.hi[2] + o.margin + style.hazard_clearance for o in world.obstacles((obj,))]
                  + [0.1]) + 0.12
     held = world.current_pose(giver)

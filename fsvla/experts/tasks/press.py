@@ -14,6 +14,9 @@ from .common import retreat_home
 
 #: Force (N) the careful press stops at where no limit watches the press.
 PRESS_FORCE = 10.0
+#: The careful press comes down PRESS_STEP (m) at a time, at most PRESS_STEPS times.
+PRESS_STEP = 0.001
+PRESS_STEPS = 40
 #: The least force (N) it presses with: ``pressed`` needs a force a sensor tells from noise.
 LEAST_PRESS = 2.0
 
@@ -43,9 +46,18 @@ def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
         reach = world.hand_reach(arm)
         yield Segment({arm: Pose(top + (reach + 0.005) * UP, R)}, speed=style.approach_speed,
                       label="touch")
-        guard = Guard(arm, press_force(world, arm, obj), obj)
-        yield Segment({arm: Pose(top - (0.03 - reach) * UP, R)},
-                      speed=0.5 * style.contact_speed, settle=20, guard=guard, label="press")
+        force = press_force(world, arm, obj)
+        guard = Guard(arm, 0.5 * force, obj)  # the arm's lead adds the rest as it stops
+        # a millimetre at a time, each step coming to rest: a stiff arm moving on at
+        # constant speed would hit the object with the lead its command has on it
+        pose = Pose(top + (reach + 0.005) * UP, R)
+        for _ in range(PRESS_STEPS):
+            if world.hand_force(arm, obj) >= 0.25 * force:
+                break
+            pose = pose.moved(-PRESS_STEP * UP)
+            yield Segment({arm: pose}, speed=0.1 * style.contact_speed, guard=guard,
+                          label="press")
+        yield Segment(settle=20, label="hold")
     else:
         yield Segment({arm: Pose(top, R)}, speed=style.approach_speed, label="touch")
         yield Segment({arm: Pose(top - np.array([0.0, 0.0, 0.01]), R)},
