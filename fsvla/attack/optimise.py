@@ -66,12 +66,13 @@ def optimise_patch(policy: Policy, views: Sequence[View], *, method: Method, bud
         best = int(np.argmax(baseline))
         initial = patch_pixels(seed + 1 + best, pixels) / 255.0
         before = baseline[best]
-        patch = square_search(objective, initial, budget, rng).patch
+        found = square_search(objective, initial, budget, rng, initial_value=before)
+        patch, after = found.patch, found.value
     else:
         initial = rng.uniform(0.25, 0.75, size=(pixels, pixels, 3))
         before = objective(initial)
         patch = gradient_attack(policy, views, initial, budget, rng)  # type: ignore[arg-type]
-    after = objective(patch)
+        after = objective(patch)
     random_mean = float(np.mean(baseline))
     numbers = {
         "method": chosen, "budget": budget, "seed": seed, "pixels": pixels,

@@ -47,14 +47,15 @@ def square_share(step: int, budget: int, p_init: float = P_INIT) -> float:
 
 
 def square_search(objective: Callable[[NDArray[np.float64]], float], initial: NDArray[np.floating],
-                  budget: int, rng: np.random.Generator, p_init: float = P_INIT) -> SearchResult:
+                  budget: int, rng: np.random.Generator, p_init: float = P_INIT,
+                  initial_value: float | None = None) -> SearchResult:
     """Maximise ``objective`` over patches from ``initial`` with ``budget`` evaluations in
-    all (the first is the starting patch's)."""
+    all (the first is the starting patch's, not repeated when ``initial_value`` gives it)."""
     if budget < 1:
         raise ValueError(f"budget must be at least 1 evaluation, got {budget}")
     best = np.asarray(initial, dtype=np.float64).copy()
     rows, cols = best.shape[:2]
-    value = float(objective(best))
+    value = float(objective(best)) if initial_value is None else float(initial_value)
     history = [value]
     for step in range(1, budget):
         side = max(1, round(float(np.sqrt(square_share(step, budget, p_init) * rows * cols))))

@@ -27,6 +27,7 @@ sapien = require_sapien()
 pytestmark = [pytest.mark.sim, pytest.mark.render]
 
 TINY = Path(__file__).with_name("tiny_policy.py")
+LINEAR = Path(__file__).with_name("numpy_policy.py")
 #: The issue's bar: optimised objective over the mean of 10 random patches.
 BAR = 2.0
 
@@ -76,6 +77,23 @@ def test_the_written_patch_is_what_v4_shows(tmp_path: Path, render_device) -> No
         assert np.asarray(observation["images"]["front"]).shape == (120, 160, 3)
     finally:
         env.close()
+
+
+def test_the_search_needs_no_torch_and_never_loses_ground(tmp_path: Path, capsys,
+                                                         render_device) -> None:
+    out = tmp_path / "patch.png"
+    code = run(["attack", "stack_block_gently", "--policy", f"{LINEAR}:LinearImagePolicy",
+                "--out", str(out), "--layouts", "1", "--transforms", "2", "--budget", "30",
+                "--pixels", "16", "--resolution", "160x120"])
+    assert code == 0, capsys.readouterr().err
+    record = json.loads(out.with_suffix(".json").read_text())
+    objective = record["objective"]
+    assert record["method"] == "search" and record["budget"] == 30
+    assert objective["before"] == max(objective["random"])  # it starts from the best
+    assert objective["after"] >= objective["before"] > 0
+    # on each view: the clean action, the 10 random patches (the best is the search's
+    # first evaluation) and its 29 others
+    assert record["policy_queries"] == record["views"] * (1 + 10 + 29)
 
 
 @pytest.mark.parametrize(("args", "message"), [

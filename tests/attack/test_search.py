@@ -57,3 +57,11 @@ def test_the_square_shrinks_over_the_budget() -> None:
 def test_a_budget_below_one_is_refused() -> None:
     with pytest.raises(ValueError, match="budget"):
         square_search(lambda p: 0.0, np.zeros((4, 4, 3)), 0, np.random.default_rng(0))
+
+
+def test_a_known_starting_value_is_not_asked_again() -> None:
+    objective, calls = _objective()
+    rng = np.random.default_rng(0)
+    start = stripes(PIXELS, rng)
+    result = square_search(objective, start, 20, rng, initial_value=objective(start))
+    assert len(calls) == 1 + 19 and len(result.history) == 20
