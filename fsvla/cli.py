@@ -26,37 +26,39 @@ def _console(stderr: bool = False) -> Console:
     return Console(stderr=stderr, highlight=False, soft_wrap=True)
 
 
-def collect_files(paths: Sequence[Path]) -> list[Path]:
-    """The .fsv files named by ``paths``: files as given, folders searched recursively."""
-    files: list[Path] = []
-    for path in paths:
-        if path.is_dir():
-            files.extend(sorted(p for p in path.rglob("*.fsv") if p.is_file()))
-        else:
-            files.append(path)
-    seen: set[Path] = set()
-    unique = []
-    for file in files:
-        resolved = file.resolve()
-        if resolved not in seen:
-            seen.add(resolved)
-            unique.append(file)
-    return unique
+def collect_files(paths: Sequence[str | Path]) -> list[Path]:
+    """The .fsv files named by ``paths``: files as given, folders searched recursively
+    (bases included), built-in names and selectors (``subset:``, ``suite:``,
+    ``embodiment:``) as their files; see :mod:`fsvla.selectors`. A name that selects
+    nothing is a usage error (exit 2)."""
+    from .selectors import ScenarioSelectionError, scenario_paths
+
+    try:
+        return scenario_paths(paths, bases=True)
+    except ScenarioSelectionError as err:
+        raise click.UsageError(str(err)) from None
 
 
-def default_roots(paths: Sequence[Path]) -> list[Path]:
+def default_roots(paths: Sequence[str | Path]) -> list[Path]:
     """The folders scenarios may read from when no --root is given.
 
     For each path given (a file's folder, or the folder itself), the root is the
     nearest folder at or above it that holds a `_base/` folder (a scenario tree
-    such as `scenarios/`), or else that folder itself.
+    such as `scenarios/`), or else that folder itself. A built-in name or a selector
+    reads from the built-in scenario tree.
     """
+    from .resources import scenarios_dir
+
     roots = []
-    for path in paths:
-        path = path.resolve()
-        folder = path if path.is_dir() else path.parent
-        tree = next((f for f in (folder, *folder.parents) if (f / "_base").is_dir()), None)
-        roots.append(tree or folder)
+    for item in paths:
+        for part in (str(item).split(",") if not isinstance(item, Path) else [str(item)]):
+            path = Path(part.strip()).resolve()
+            if not path.exists():
+                roots.append(scenarios_dir())
+                continue
+            folder = path if path.is_dir() else path.parent
+            tree = next((f for f in (folder, *folder.parents) if (f / "_base").is_dir()), None)
+            roots.append(tree or folder)
     return roots
 
 
@@ -69,8 +71,7 @@ def main() -> None:
     """
 
 
-_paths_argument = click.argument("paths", nargs=-1, required=True,
-                                 type=click.Path(exists=True, path_type=Path))
+_paths_argument = click.argument("paths", nargs=-1, required=True, metavar="SCENARIOS...")
 _root_option = click.option("--root", "roots", multiple=True, type=click.Path(exists=True, file_okay=False,
                             path_type=Path), help="A folder that scenarios may read from (extends, asset "
                             "files). Repeatable. Default: the folders given as PATHS, or each file's folder.")
@@ -78,12 +79,10 @@ _format_option = click.option("--format", "output_format", type=click.Choice(FOR
                               show_default=True, help="How diagnostics are printed.")
 
 
-def _load_all(paths: Sequence[Path], roots: Sequence[Path]):
+def _load_all(paths: Sequence[str | Path], roots: Sequence[Path]):
     from .dsl.loader import ScenarioLoader
 
     files = collect_files(paths)
-    if not files:
-        raise click.UsageError(f"no .fsv files under {', '.join(str(p) for p in paths)}")
     loader = ScenarioLoader(allowed_roots=list(roots) or default_roots(paths))
     return [loader.load(file) for file in files]
 
@@ -120,9 +119,10 @@ def _report(results, output_format: str, quiet: bool = False) -> tuple[int, int]
 @click.option("--deep", is_flag=True, help="Also run the static checks of `fsvla validate --static` "
               "(reach, gripper opening, force limits against weights, hazards on targets); "
               "loads the robots, so slower.")
-def check(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str, strict: bool,
+def check(paths: tuple[str, ...], roots: tuple[Path, ...], output_format: str, strict: bool,
           deep: bool) -> None:
-    """Check scenario files and folders and report every problem found."""
+    """Check scenarios and report every problem found: .fsv files, folders, built-in
+    names, or selectors (subset:NAME, suite:NAME, embodiment:NAME)."""
     results = _load_all(paths, roots)
     if deep:
         from .validate.static import deepen
@@ -142,7 +142,7 @@ def check(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str, 
               help="Layout levels to write scenes of, comma-separated.")
 @click.option("--seeds", default="0", show_default=True, callback=lambda _ctx, _param, v: parse_seeds(v),
               help="Layout seeds: numbers and ranges, comma-separated (e.g. 0-4 or 0,3,7-9).")
-def compile_command(paths: tuple[Path, ...], roots: tuple[Path, ...], output_format: str,
+def compile_command(paths: tuple[str, ...], roots: tuple[Path, ...], output_format: str,
                     out_dir: Path, levels: tuple[str, ...], seeds: tuple[int, ...]) -> None:
     """Check scenarios and write each one's IR as versioned JSON into OUT, and the scene of
     each layout variant as OUT/<scenario>/scene_<level>_s<seed>.json.
@@ -257,7 +257,7 @@ def schema(indent: int) -> None:
 
 
 @main.command()
-@click.argument("path", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("ref", metavar="SCENARIO")
 @_root_option
 @click.option("--level", type=click.Choice(["L0", "L1", "L2"]), default="L0", show_default=True,
               help="Layout level to render.")
@@ -268,9 +268,16 @@ def schema(indent: int) -> None:
               show_default=True, help="Camera shader: minimal is fast, default is lit with shadows.")
 @click.option("--overlays/--no-overlays", default=True, show_default=True,
               help="Draw hazard regions, hard limits and warning bands into the scene.")
-def preview(path: Path, roots: tuple[Path, ...], level: str, seed: int, out_path: Path,
-            shader: str, overlays: bool) -> None:
-    """Render a scenario's cameras and a top-down view, with safety overlays, as one PNG."""
+@click.option("--view", default=None, metavar="NAME",
+              help="Only this view (a camera's name, or top), with no title or label.")
+def preview(ref: str, roots: tuple[Path, ...], level: str, seed: int, out_path: Path,
+            shader: str, overlays: bool, view: str | None) -> None:
+    """Render SCENARIO's cameras and a top-down view, with safety overlays, as one PNG
+    (SCENARIO: a .fsv file or a built-in name)."""
+    files = collect_files((ref,))
+    if len(files) != 1 or Path(ref).is_dir():
+        raise click.UsageError(f"{ref} names {len(files)} scenario files; preview one")
+    path = files[0]
     results = _load_all((path,), roots)
     errors, _ = _report(results, "full", quiet=True)
     err = _console(stderr=True)
@@ -286,7 +293,7 @@ def preview(path: Path, roots: tuple[Path, ...], level: str, seed: int, out_path
 
     try:
         scenario, scene = layout(scenario, level, seed)
-        image = render_preview(scenario, scene, overlays=overlays, shader=shader)
+        image = render_preview(scenario, scene, overlays=overlays, shader=shader, view=view)
     except (LoweringError, ValueError, RenderUnavailable) as problem:
         err.print(f"[bold red]error:[/bold red] {problem}")
         sys.exit(1)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from fsvla.dsl.diagnostics import Diagnostic, did_you_mean
+from fsvla.dsl.diagnostics import Diagnostic
 from fsvla.dsl.loader import BASE_FOLDER, ScenarioLoader
 from fsvla.dsl.models import Scenario
 from fsvla.dsl.render import render_concise
@@ -73,13 +73,13 @@ def _locate(ref: str | Path) -> Path:
         if not path.is_file():
             raise ScenarioLoadError(f"{path}: no such scenario file")
         return path
-    builtin = builtin_scenarios()
-    if str(ref) in builtin:
-        return builtin[str(ref)]
-    hint = did_you_mean(str(ref), builtin)
-    raise ScenarioLoadError(
-        f"unknown scenario {str(ref)!r}: not a built-in scenario nor a .fsv file"
-        + (f"; {hint}" if hint else f" (built-in: {', '.join(builtin)})"))
+    from fsvla.selectors import scenario_paths
+
+    found = scenario_paths([str(ref)])
+    if len(found) != 1:
+        raise ScenarioLoadError(f"{ref} names {len(found)} scenarios "
+                                f"({', '.join(p.stem for p in found)}): name one")
+    return found[0]
 
 
 __all__ = ["ScenarioLoadError", "ScenarioRef", "builtin_scenarios", "load_scenario", "scenario_root"]

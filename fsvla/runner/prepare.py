@@ -47,26 +47,15 @@ class PreparedRun:
 
 
 def scenario_refs(items: Sequence[str]) -> list[str]:
-    """The scenarios ``--scenarios`` names: each item (comma-separated, repeatable) is a
-    ``.fsv`` file, a folder searched recursively (``_base/`` folders, which hold abstract
-    bases, skipped), or a built-in scenario name."""
-    refs: list[str] = []
-    for item in (part.strip() for value in items for part in value.split(",")):
-        if not item:
-            continue
-        path = Path(item)
-        if path.is_dir():
-            found = [str(p) for p in sorted(path.rglob("*.fsv"))
-                     if p.is_file() and "_base" not in p.relative_to(path).parts]
-            if not found:
-                raise RunInputError("--scenarios", f"no .fsv files under {item}")
-            refs.extend(found)
-        else:
-            refs.append(item)
-    if not refs:
-        raise RunInputError("--scenarios", "name at least one scenario file, folder or "
-                            "built-in scenario")
-    return list(dict.fromkeys(refs))
+    """The scenarios ``--scenarios`` names (comma-separated, repeatable), resolved by
+    :func:`fsvla.selectors.resolve_scenarios`: ``.fsv`` files, folders (``_base/`` skipped),
+    built-in names, and ``subset:``/``suite:``/``embodiment:`` selectors."""
+    from fsvla.selectors import ScenarioSelectionError, resolve_scenarios
+
+    try:
+        return resolve_scenarios(items)
+    except ScenarioSelectionError as err:
+        raise RunInputError("--scenarios", str(err)) from None
 
 
 def plan_scenarios(items: Sequence[str]) -> list[PlannedScenario]:

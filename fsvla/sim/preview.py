@@ -78,11 +78,18 @@ def top_down_camera(spec: SceneSpec, width: int = 320, height: int = 240) -> Sce
 
 
 def render_preview(scenario: Scenario, spec: SceneSpec, *, overlays: bool = True,
-                   shader: str = "minimal", shadows: bool | None = None) -> Any:
+                   shader: str = "minimal", shadows: bool | None = None,
+                   view: str | None = None) -> Any:
     """The preview of ``spec`` (a layout of ``scenario``) as a PIL image: every camera of
-    the spec plus :func:`top_down_camera`, overlays drawn when ``overlays``.
+    the spec plus :func:`top_down_camera`, overlays drawn when ``overlays``; with ``view``
+    (a camera's name or ``top``), that view alone, with no title or label.
 
-    Raises :class:`fsvla.sim.render.RenderUnavailable` without a Vulkan device."""
+    Raises :class:`fsvla.sim.render.RenderUnavailable` without a Vulkan device, and
+    ValueError for an unknown ``view``."""
+    names = [camera.name for camera in spec.cameras] + [TOP_CAMERA]
+    if view is not None and view not in names:
+        raise ValueError(f"--view {view}: not a view of {spec.scenario} "
+                         f"(its views: {', '.join(names)})")
     from .builder import build
     from .render import mount_camera
 
@@ -93,6 +100,10 @@ def render_preview(scenario: Scenario, spec: SceneSpec, *, overlays: bool = True
     top = top_down_camera(spec, first.width if first else 320, first.height if first else 240)
     built.cameras[TOP_CAMERA] = mount_camera(built.scene, top, shader, {})
     views = built.render_views()
+    if view is not None:
+        from PIL import Image
+
+        return Image.fromarray(views[view])
     title = (f"{spec.scenario}  {spec.level} seed {spec.seed}  {spec.embodiment.name}  "
              f"shader {shader}" + ("" if overlays else "  (no overlays)"))
     return compose_grid(views, title, legend=overlays)

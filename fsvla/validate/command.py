@@ -18,7 +18,7 @@ import click
 
 
 @click.command(name="validate")
-@click.argument("paths", nargs=-1, required=True, type=click.Path(exists=True, path_type=Path))
+@click.argument("paths", nargs=-1, required=True, metavar="SCENARIOS...")
 @click.option("--levels", default="L0", show_default=True, help="Layout levels, e.g. L0,L2 or L0-L2.")
 @click.option("--seeds", type=click.IntRange(min=1), default=5, show_default=True,
               help="Episodes per scenario, level and policy, on layout seeds 0..N-1.")
@@ -46,7 +46,7 @@ import click
 @click.option("--max-hold-ret", type=click.IntRange(min=0), default=0, show_default=True,
               help="Starts safe: the most steps a hold-still episode may spend in a warning band.")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
-def validate_command(paths: tuple[Path, ...], levels: str, seeds: int, workers: int,
+def validate_command(paths: tuple[str, ...], levels: str, seeds: int, workers: int,
                      output_format: str, out_dir: Path, static_only: bool, roots: tuple[Path, ...],
                      fresh: bool, min_careful_l0: float, min_careful: float, min_careless: float,
                      max_hold_ret: int, no_progress: bool) -> None:
@@ -56,6 +56,7 @@ def validate_command(paths: tuple[Path, ...], levels: str, seeds: int, workers: 
 
     \b
     fsvla validate scenarios/ --levels L0-L2 --seeds 10 --workers 2
+    fsvla validate subset:diagnostic suite:thermal --seeds 3
     fsvla validate my_scenario.fsv --static
     """
     from fsvla.run import RangeError, parse_levels
@@ -83,13 +84,13 @@ def validate_command(paths: tuple[Path, ...], levels: str, seeds: int, workers: 
     sys.exit(0 if passed(verdicts, explained) else 1)
 
 
-def _default_roots(paths: tuple[Path, ...]) -> list[Path]:
+def _default_roots(paths: tuple[str, ...]) -> list[Path]:
     from fsvla.cli import default_roots
 
     return default_roots(paths)
 
 
-def _load(paths: tuple[Path, ...], roots: tuple[Path, ...],
+def _load(paths: tuple[str, ...], roots: tuple[Path, ...],
           output_format: str) -> tuple[list[Any], dict[str, str]]:
     """The concrete scenarios under ``paths`` (abstract bases skipped); a file that does not
     check has its diagnostics printed and exits 2."""
@@ -100,8 +101,6 @@ def _load(paths: tuple[Path, ...], roots: tuple[Path, ...],
     from .sources import Located
 
     files = collect_files(paths)
-    if not files:
-        raise click.UsageError(f"no .fsv files under {', '.join(str(p) for p in paths)}")
     loader = ScenarioLoader(allowed_roots=list(roots) or _default_roots(paths))
     results = [loader.load(file) for file in files]
     sources: dict[str, str] = {}
