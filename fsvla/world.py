@@ -111,6 +111,11 @@ class ArmModel(Protocol):
         """Positions (n, 3) and quaternions (n, 4) of ``links`` at arm joints ``arm_q``."""
         ...
 
+    def finger_points(self, fraction: float) -> NDArray[np.float64]:
+        """World positions (2, 3) of the points of the first two fingers that lie on the
+        TCP when the gripper is closed, with it open by ``fraction`` (the arm as it is)."""
+        ...
+
     def link_vertices(self, link: int) -> NDArray[np.float64] | None:
         """The vertices of a link's convex collision pieces in its own frame (None: none)."""
         ...

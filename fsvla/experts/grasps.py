@@ -126,11 +126,12 @@ def _mug(world: World, arm: str, obj: str) -> list[Grasp]:
     except StopIteration:
         return _cylinder(world, arm, obj)
     pose = world.body_pose(obj)
-    inner = float(high.pose.position[0] - high.half_size[0])
-    outer = float(grip.pose.position[0] + grip.half_size[0])
+    side = 1.0 if grip.pose.position[0] >= 0 else -1.0  # a mug's handle is on +x, a kettle's on -x
+    inner = float(high.pose.position[0] - side * high.half_size[0])
+    outer = float(grip.pose.position[0] + side * grip.half_size[0])
     z = float(high.pose.position[2])
     centre = world.to_world(obj, (0.5 * (inner + outer), 0.0, z))
-    return [top_down_grasp(world, arm, centre, pose.R[:, 0], outer - inner)]
+    return [top_down_grasp(world, arm, centre, pose.R[:, 0], abs(outer - inner))]
 
 
 def _rim(world: World, arm: str, obj: str, r: float, h: float,
@@ -224,7 +225,7 @@ def reach_handle(world: World, arm: str, obj: str, handle: str, back: float = 0.
 
 _MAKERS = {
     "glass": _cylinder, "bottle": _cylinder, "mug": _mug, "vase": _cylinder,
-    "bowl": _cylinder, "kettle": _cylinder, "block": _block, "knife": _knife,
+    "bowl": _cylinder, "kettle": _mug, "block": _block, "knife": _knife,
 }
 
 __all__ = ["HANDLE_PITCHES", "choose", "grasps", "handle_grasp", "reach_handle"]

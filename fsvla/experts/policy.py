@@ -20,14 +20,17 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Iterator
 from dataclasses import replace
+from itertools import chain
 from typing import Any
 
 import numpy as np
 
 from fsvla.compiler.pose import quat_to_matrix
+from fsvla.dsl.catalog import BIMANUAL_TASKS
 
 from .clearance import ArmClearance
 from .motion import ArmDriver, Pose, Segment, Step, expand
+from .skills import nearest_arm, park_others
 from .style import CAREFUL, CARELESS, STYLES, Style
 from .tasks import TASK_PLANS
 from .world import World
@@ -93,7 +96,12 @@ class ExpertPolicy:
             if self.style.avoid_hazards:  # its links too, not only the hand, kept clear
                 clearance = ArmClearance(world, name)
                 self._drivers[name].clearance = clearance if clearance.active else None
-        self._plan = TASK_PLANS[task.name].plan(world, self.style, dict(task.roles))
+        plan = TASK_PLANS[task.name].plan(world, self.style, dict(task.roles))
+        if task.name not in BIMANUAL_TASKS and len(world.arm_names) > 1:
+            # one arm works: the other first moves out of its way (where arms are kept apart)
+            active = nearest_arm(world, world.body_pose(task.roles["object"]).p)
+            plan = chain(park_others(world, self.style, active), plan)
+        self._plan = plan
         self._queue.clear()
         self._last = None
         self.log = []

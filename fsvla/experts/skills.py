@@ -37,6 +37,9 @@ PAD_RADIUS = 0.004
 #: edge of each pad). Measured: a 300 g mug held by its handle, its centre 3-4 cm out along
 #: the closing axis, swings loose in a carry at 8-12 N and stays put at 16 N.
 PAD_TIP_ARM = 0.01
+#: How far (m) wider than the object a gripper with one fixed jaw reckons the object
+#: when it places that jaw beside it.
+FIXED_JAW_CLEARANCE = 0.004
 #: A careful grip whose fingers are still short of the object closes on by this fraction
 #: of the gripper's range at a time, at most this many times, until the squeeze is felt.
 SQUEEZE_STEP = 0.05
@@ -143,9 +146,11 @@ def grasp_tip(world: World, arm: str, obj: str, tcp: Pose | None = None) -> floa
 
 
 def clear_height(world: World, style: Style, a: NDArray[np.float64], b: NDArray[np.float64],
-                 below: float, exclude: tuple[str, ...] = (), keep_height: bool = True) -> float:
+                 below: float, exclude: tuple[str, ...] = (), keep_height: bool = True,
+                 around: float = 0.0) -> float:
     """TCP height at which a move from ``a`` to ``b`` clears the obstacles under its path;
-    ``below`` is how far the carried load (or the fingers) reaches under the TCP. At least
+    ``below`` is how far the carried load (or the fingers) reaches under the TCP, ``around``
+    how much farther than 4 cm it reaches out sideways (a kettle held by its rim). At least
     the start's height with ``keep_height``, else only what the obstacles need."""
     height = max(a[2], b[2]) if keep_height else float(b[2])
     boxes = []
@@ -159,7 +164,8 @@ def clear_height(world: World, style: Style, a: NDArray[np.float64], b: NDArray[
         lo, hi = world.bounds(body.name)
         boxes.append((lo, hi, 0.02))
     for lo, hi, margin in boxes:
-        if _segment_hits_box(a[:2], b[:2], lo[:2] - margin - 0.04, hi[:2] + margin + 0.04):
+        grow = margin + 0.04 + around
+        if _segment_hits_box(a[:2], b[:2], lo[:2] - grow, hi[:2] + grow):
             height = max(height, hi[2] + margin + below)
     return float(height)
 
@@ -174,7 +180,8 @@ def _segment_hits_box(a, b, lo, hi) -> bool:
 
 def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.02,
             exclude: tuple[str, ...] = (), start: Pose | None = None,
-            then: Pose | None = None, follow: tuple[Pose, ...] = ()) -> Plan:
+            then: Pose | None = None, follow: tuple[Pose, ...] = (),
+            around: float = 0.0) -> Plan:
     """Straight up to a height that clears the obstacles under the path, a free-space
     (joint-space) move to above ``goal`` at that height, and straight down to it. The
     careless style's clear height ignores the hazards (zones and hazard objects), and
@@ -182,15 +189,22 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
     ``follow``: the poses the hand goes through after ``goal`` (an arc); the free-space
     move ends on an IK branch from which all of them are reached (:func:`branch_for_path`)."""
     a = world.current_pose(arm) if start is None else start
-    clear = clear_height(world, style, a.p, goal.p, below, exclude)
+    clear = clear_height(world, style, a.p, goal.p, below, exclude, around=around)
     height = max(clear, goal.p[2] + 0.05)
-    out = horizontal(goal.p - world.base_position(arm)) * REACH_SLACK
-    if height > goal.p[2] + 0.06 and branch_for_path(
-            world, arm, (Pose(np.array([goal.p[0], goal.p[1], height]) + out, goal.R),)) is None:
+    def beyond_reach(p: NDArray[np.float64], R: NDArray[np.float64]) -> bool:
+        slack = horizontal(p - world.base_position(arm)) * REACH_SLACK
+        return branch_for_path(world, arm, (Pose(p + slack, R),)) is None
+
+    if height > goal.p[2] + 0.06 and (
+            beyond_reach(np.array([goal.p[0], goal.p[1], height]), goal.R)
+            or beyond_reach(np.array([a.p[0], a.p[1], height]), a.R)):
         # a far goal is at the edge of the reach (or beyond) at the start's height, where
         # the line down may straighten the elbow onto its limit: cross only as high as needed
-        clear = clear_height(world, style, a.p, goal.p, below, exclude, keep_height=False)
+        clear = clear_height(world, style, a.p, goal.p, below, exclude, keep_height=False,
+                             around=around)
         height = max(clear, goal.p[2] + 0.05)
+    # a small arm (an SO-101 reaches 9 cm above the table) crosses as high as it reaches
+    height = min(height, max(goal.p[2], reach_ceiling(world, arm, goal.p, goal.R, height)))
     # careless: a diagonal line to above the goal unless a task object is in the way
     direct = not style.avoid_hazards and clear <= max(a.p[2], goal.p[2]) + 1e-3
     if height > a.p[2] + 1e-3 and not direct:
@@ -202,6 +216,23 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
                   branch_of={arm: then if then is not None else goal},
                   joints={arm: q} if q is not None else {})
     yield Segment({arm: goal}, speed=style.transit_speed, label="down")
+
+
+def reach_ceiling(world: World, arm: str, p: NDArray[np.float64], R: NDArray[np.float64],
+                  high: float) -> float:
+    """The highest TCP height up to ``high`` at which the arm holds the hand ``R`` over
+    ``p``'s x, y comfortably (:func:`branch_for_path`); ``high`` when it reaches it, and at
+    least ``p``'s own height (m)."""
+    def reached(z: float) -> bool:
+        return branch_for_path(world, arm, (Pose(np.array([p[0], p[1], z]), R),)) is not None
+
+    if reached(high):
+        return float(high)
+    lo, hi = float(p[2]), float(high)
+    for _ in range(5):  # to a centimetre or so
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if reached(mid) else (lo, mid)
+    return lo
 
 
 #: How far (rad or m) inside its joint limits a path :func:`branch_for_path` checks stays,
@@ -258,17 +289,58 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
     return best
 
 
+#: How far (m) an idle arm moves its hand away from the working arm, at most, when a
+#: `separation` limit watches the two.
+PARK_OUT = 0.12
+
+
+def park_others(world: World, style: Style, arm: str) -> Plan:
+    """Careful, on a robot whose arms a ``separation`` limit keeps apart: move every other
+    arm's hand away from ``arm`` (along the line between their bases, out of the way of
+    the arm about to work), as far as PARK_OUT that it reaches. Baxter's idle arm stands
+    right beside the other's work at home."""
+    if not style.avoid_hazards or len(world.arm_names) < 2 or not any(
+            c.metric == "separation" for c in world.monitor.channels):
+        return
+    targets = {}
+    for other in world.arm_names:
+        if other == arm:
+            continue
+        away = horizontal(world.base_position(other) - world.base_position(arm))
+        now = world.current_pose(other)
+        for out in (PARK_OUT, 0.6 * PARK_OUT, 0.3 * PARK_OUT):
+            pose = now.moved(out * away)
+            if branch_for_path(world, other, (now, pose)) is not None:
+                targets[other] = pose
+                break
+    if targets:
+        yield Segment(targets, speed=free_speed(style), label="park")
+
+
 def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
          pre_distance: float = 0.1) -> Plan:
-    """Open, come to ``grasp`` along its approach direction, close, lift."""
-    yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, label="open")
+    """Open, come to ``grasp`` along its approach direction, close, lift. ``grasp`` puts
+    the middle between the fingers on the object; a gripper with one fixed jaw puts its
+    TCP off that middle (:meth:`World.grip_centre`)."""
+    # the fixed jaw a little outside the object's face, not on its edge
+    shift = grasp.pose.R @ world.grip_centre(arm, grasp.width + FIXED_JAW_CLEARANCE)
+    if float(np.linalg.norm(shift)) > 0.002:
+        grasp = Grasp(Pose(grasp.pose.p - shift, grasp.pose.R), grasp.width, grasp.approach)
+    yield Segment(grippers={arm: world.pregrasp_opening(arm, grasp.width)},
+                  gripper_steps=style.gripper_steps, label="open")
     pre = grasp.pose.moved(-pre_distance * grasp.approach)
+    if grasp.approach[2] < -0.7:  # from above: no higher than the arm reaches
+        top = reach_ceiling(world, arm, grasp.pose.p, grasp.pose.R, float(pre.p[2]))
+        pre = Pose(np.array([pre.p[0], pre.p[1], max(grasp.pose.p[2] + 0.02, top)]), pre.R)
     yield from transit(world, style, arm, pre, exclude=(obj,), then=grasp.pose)
     yield Segment({arm: grasp.pose.moved(-0.02 * grasp.approach)}, speed=style.approach_speed,
                   label="approach")
     yield Segment({arm: grasp.pose}, speed=gentle(world, style, obj), label="reach")
     yield from close_on(world, style, arm, obj, grasp.width)
-    yield Segment({arm: grasp.pose.moved(style.lift_height * UP)}, speed=free_speed(style),
+    lift = min(style.lift_height, max(0.02, reach_ceiling(
+        world, arm, grasp.pose.p, grasp.pose.R, grasp.pose.p[2] + style.lift_height)
+        - grasp.pose.p[2]))
+    yield Segment({arm: grasp.pose.moved(lift * UP)}, speed=free_speed(style),
                   label="lift")
 
 
@@ -287,7 +359,8 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     heavy = float(world.asset(obj).mass) > LIGHT_LOAD
     carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
         if style.avoid_hazards and heavy else style
-    yield from transit(world, carrying, arm, goal.moved(0.08 * UP), below=below, exclude=(obj,))
+    yield from transit(world, carrying, arm, goal.moved(0.08 * UP), below=below, exclude=(obj,),
+                       around=load_reach(world, arm, obj))
     # the object may have slipped in the fingers on the way: aim with where it is now
     now = R @ held_offset(world, arm, obj)
     if float(np.linalg.norm(now - offset)) > 0.05:  # dropped: nothing left to place
@@ -327,7 +400,9 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
     # neither crushes the object nor leaves it loose
     force = float(held.grip_force or 0.0)
     guard = Guard(arm, force, obj, hold_measured=False)
-    if _force_watched(world, obj):
+    if _force_watched(world, obj) or not world.fingers_slide(arm):
+        # slowly over the last millimetres: a jaw on a hinge swinging shut at speed knocks
+        # the object across the table before it squeezes it
         near = float(np.clip((width + 0.006) / world.max_width(arm), 0.0, 1.0))
         yield Segment(grippers={arm: near}, gripper_steps=style.gripper_steps, label="preclose")
         yield Segment(grippers={arm: target}, gripper_steps=2 * style.gripper_steps,
@@ -343,6 +418,15 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
         goal = max(0.0, goal - SQUEEZE_STEP)
         yield Segment(grippers={arm: goal}, gripper_steps=style.gripper_steps, settle=2,
                       guard=guard, label="squeeze")
+
+
+def load_reach(world: World, arm: str, obj: str) -> float:
+    """How much farther than 4 cm (m) the held ``obj`` reaches out sideways from the TCP:
+    what a carry's obstacle boxes grow by (a mug by its handle, a kettle by its rim)."""
+    lo, hi = world.bounds(obj)
+    tcp = world.current_pose(arm).p
+    corners = np.array([[x, y] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])])
+    return max(0.0, float(np.max(np.linalg.norm(corners - tcp[:2], axis=1))) - 0.04)
 
 
 def held_offset(world: World, arm: str, obj: str) -> NDArray[np.float64]:
@@ -382,8 +466,10 @@ __all__ = [
     "grip_force",
     "held_offset",
     "horizontal",
+    "load_reach",
     "nearest_arm",
     "opening_for",
+    "park_others",
     "pick",
     "place",
     "top_down_grasp",

@@ -49,6 +49,7 @@ class World:
         self.dt = float(dt)
         self._kinematics: dict[str, ArmModel] = {}
         self._finger_axis: dict[str, NDArray[np.float64]] = {}
+        self._open_width: dict[str, float] = {}
 
     @classmethod
     def of_env(cls, env: Any) -> World:
@@ -155,7 +156,7 @@ class World:
             fingers = self.arm_spec(arm).gripper.finger_links
             if len(fingers) > 1:
                 R = quat_to_matrix(self.state.tcp_pose(arm).q)
-                a, b = (np.asarray(self.state.robot_link_pose(arm, f).p) for f in fingers[:2])
+                a, b = self.kinematics(arm).finger_points(1.0)
                 axis = R.T @ (b - a)
             else:
                 axis = np.array([0.0, 1.0, 0.0])
@@ -166,10 +167,57 @@ class World:
     def approach_axis(self, arm: str) -> NDArray[np.float64]:
         return np.asarray(AXES[self.arm_spec(arm).approach_axis], dtype=np.float64)
 
-    def max_width(self, arm: str) -> float:
-        """The gripper's opening (m between the fingers) when fully open."""
+    def travel(self, arm: str) -> float:
+        """How far the gripper's joints move from closed to open, summed (m for sliding
+        fingers; radians for a jaw on a hinge)."""
         spec = self.arm_spec(arm).gripper
         return float(sum(abs(o - c) for o, c in zip(spec.open, spec.closed)))
+
+    def open_width(self, arm: str) -> float:
+        """How far apart (m) the fingers' points that meet at the TCP when closed are when
+        the gripper is open (:meth:`fsvla.world.ArmModel.finger_points`)."""
+        if arm not in self._open_width:
+            if len(self.arm_spec(arm).gripper.finger_links) < 2:
+                self._open_width[arm] = self.travel(arm)
+            else:
+                a, b = self.kinematics(arm).finger_points(1.0)
+                self._open_width[arm] = float(np.linalg.norm(b - a))
+        return self._open_width[arm]
+
+    def grip_centre(self, arm: str, width: float) -> NDArray[np.float64]:
+        """Where, in the TCP's frame, the middle between the fingers is when they are
+        ``width`` apart: zero for fingers that close symmetrically (a Panda hand), half the
+        width toward the moving jaw for a gripper with one fixed jaw (SO-101, Z1), whose
+        TCP is where the jaws meet."""
+        if len(self.arm_spec(arm).gripper.finger_links) < 2:
+            return np.zeros(3)
+        kin = self.kinematics(arm)
+        lo, hi = 0.0, 1.0
+        for _ in range(14):  # the opening whose gap is ``width``
+            mid = 0.5 * (lo + hi)
+            a, b = kin.finger_points(mid)
+            lo, hi = (mid, hi) if np.linalg.norm(b - a) < width else (lo, mid)
+        a, b = kin.finger_points(hi)
+        tcp = self.current_pose(arm)
+        return tcp.R.T @ (0.5 * (a + b) - tcp.p)
+
+    def fingers_slide(self, arm: str) -> bool:
+        """Whether the fingers' opening is their joints' travel (parallel sliding fingers
+        that meet when closed, as a Panda hand's), not a jaw on a hinge or fingers that
+        stop apart."""
+        return abs(self.open_width(arm) - self.travel(arm)) <= 0.01
+
+    def max_width(self, arm: str) -> float:
+        """The gripper's opening (m between the fingers) when fully open."""
+        return self.travel(arm) if self.fingers_slide(arm) else self.open_width(arm)
+
+    def pregrasp_opening(self, arm: str, width: float) -> float:
+        """How far to open the gripper before closing on an object ``width`` wide: fully
+        for sliding fingers; for others only as far as needed with 2.5 cm to spare (an
+        SO-101's open jaw swings down past its TCP and into the table beside a block)."""
+        if self.fingers_slide(arm):
+            return 1.0
+        return float(np.clip((width + 0.025) / self.open_width(arm), 0.3, 1.0))
 
     def gripper_stiffness(self, arm: str) -> float:
         return float(self.arm_spec(arm).gripper.drive.stiffness)

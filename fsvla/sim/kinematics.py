@@ -77,6 +77,31 @@ class ArmKinematics:
         return (np.array([pose.p for pose in poses]).reshape(-1, 3),
                 np.array([pose.q for pose in poses]).reshape(-1, 4))
 
+    def finger_points(self, fraction: float) -> NDArray[np.float64]:
+        """World positions (2, 3) of the points of the first two finger links that lie on
+        the TCP when the gripper is closed, with the gripper open by ``fraction`` and the
+        arm where it is: their distance is the opening at the TCP, their difference the
+        direction the fingers close along (the same measure ``fsvla validate`` takes)."""
+        fingers = self.arm.finger_links[:2]
+        links = self.arm.articulation.get_links()
+        indices = [next(i for i, lk in enumerate(links) if lk.name == f.name) for f in fingers]
+        root = self.arm.articulation.get_root_pose()
+        gripper = self.arm.spec.gripper
+
+        def at(f: float) -> tuple[Any, list[Any]]:
+            full = self._full(None)
+            for index, lo, hi in zip(self.arm.gripper_indices, gripper.closed, gripper.open):
+                full[index] = lo + f * (hi - lo)
+            self._model.compute_forward_kinematics(full)
+            tcp = root * self._model.get_link_pose(self.arm.ee_link_index) * self._tcp
+            return tcp, [root * self._model.get_link_pose(i) for i in indices]
+
+        tcp, closed = at(0.0)
+        held = [pose.inv() * tcp for pose in closed]  # the TCP in each finger's frame
+        _, opened = at(fraction)
+        return np.array([(pose * point).p for pose, point in zip(opened, held)],
+                        dtype=np.float64)
+
     def link_vertices(self, link: int) -> NDArray[np.float64] | None:
         """The vertices of a link's convex collision pieces, in the link's frame."""
         parts = []

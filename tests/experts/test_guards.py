@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 
 from fsvla.experts.rollout import rollout
+from fsvla.experts.tasks.press import PRESS_STEPS
 
 pytestmark = pytest.mark.sim
 
@@ -65,7 +66,8 @@ def test_careful_press_stops_at_the_force_it_feels(tmp_path, x, y, limit, warn):
     path = _write(tmp_path, "press_block", PRESS.format(x=x, y=y, limit=limit, warn=warn))
     careful = rollout(path, "careful")
     assert careful.safe_success, careful.summary()
-    assert "stopped by force" in careful.segments
+    # it stopped because it felt the block, not at the end of its way down
+    assert 0 < careful.segments.count("press") < PRESS_STEPS, careful.segments
     careless = rollout(path, "careless")  # a centimetre into the block at full speed
     assert careless.violation, careless.summary()
 

@@ -57,7 +57,17 @@ class FakeState:
 
     def arm_model(self, arm: str) -> object:
         self.reads.append(f"model {arm}")
-        return f"model of {arm}"
+        return FakeModel(arm)
+
+
+@dataclass
+class FakeModel:
+    """A parallel gripper 8 cm wide at (0.3, 0, 0.4), closing along world y."""
+
+    arm: str
+
+    def finger_points(self, fraction: float) -> np.ndarray:
+        return np.array([(0.3, 0.04 * fraction, 0.4), (0.3, -0.04 * fraction, 0.4)])
 
 
 @pytest.fixture(scope="module")
@@ -111,7 +121,11 @@ def test_the_arm(drawer) -> None:
     assert world.current_pose("arm").p == pytest.approx((0.3, 0.0, 0.4))
     # left to right finger is world -y; the TCP is turned a half turn about x: local +y
     assert world.finger_axis("arm") == pytest.approx((0.0, 1.0, 0.0))
-    assert world.kinematics("arm") == world.kinematics("arm") == "model of arm"
+    assert world.open_width("arm") == pytest.approx(0.08)
+    assert world.fingers_slide("arm")  # the Panda hand's 2 × 4 cm travel is its opening
+    assert world.grip_centre("arm", 0.05) == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
+    assert world.kinematics("arm") is world.kinematics("arm")
+    assert world.kinematics("arm").arm == "arm"
     assert state.reads.count("model arm") == 1  # made once, kept
     with pytest.raises(KeyError, match="has no arm `left`"):
         world.arm_spec("left")
@@ -130,3 +144,26 @@ def test_hazard_objects_are_obstacles_where_they_stand() -> None:
     state.bodies["vase"] = _pose((0.1, 0.3, 0.0))  # the vase moved: so does its box
     moved = next(o for o in world.obstacles() if o.name == "vase")
     assert moved.lo - found["vase"].lo == pytest.approx((0.0, 0.1, 0.0))
+
+
+@dataclass
+class FixedJawModel:
+    """One jaw fixed at the TCP (0.3, 0, 0.4), the other swinging out 12 cm along -y."""
+
+    arm: str
+
+    def finger_points(self, fraction: float) -> np.ndarray:
+        return np.array([(0.3, 0.0, 0.4), (0.3, -0.12 * fraction, 0.4)])
+
+
+def test_a_fixed_jaw_grips_off_its_tcp(drawer) -> None:
+    state = FakeState({})
+    state.arm_model = lambda arm: FixedJawModel(arm)  # type: ignore[method-assign]
+    world = _world(drawer, state)
+    assert world.open_width("arm") == pytest.approx(0.12)
+    assert not world.fingers_slide("arm")  # its opening is not the Panda joints' travel
+    assert world.max_width("arm") == pytest.approx(0.12)
+    # a 3 cm object sits between the jaws 1.5 cm from the fixed one (local +y: the TCP
+    # is turned a half turn about x)
+    assert world.grip_centre("arm", 0.03) == pytest.approx((0.0, 0.015, 0.0), abs=1e-4)
+    assert world.pregrasp_opening("arm", 0.03) == pytest.approx((0.03 + 0.025) / 0.12)

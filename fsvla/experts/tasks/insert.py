@@ -57,7 +57,10 @@ def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
     obj, target = roles["object"], roles["target"]
     asset = world.asset(target)
     if not getattr(asset, "parts", None):
-        yield from plan_pick_place(world, style, roles)
+        if getattr(asset, "cavity", None) is not None:  # a pot, a bowl, a mug: into it
+            yield from _insert_into_cavity(world, style, obj, target)
+        else:
+            yield from plan_pick_place(world, style, roles)
         return
     part, joint = world.part(target)
     if joint.type == "revolute" and part.name == "lid":
@@ -99,6 +102,18 @@ def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
         bottom = np.array([link.p[0], tcp_x[1] - offset[1], bottom[2]])
     yield from place(world, style, arm, obj, bottom, rotation=R, retreat=0.08)
     yield from plan_move_part(world, style, target, 0.0)
+
+
+def _insert_into_cavity(world: World, style: Style, obj: str, target: str) -> Plan:
+    """An open container: pick the object and set it down on the floor of the container's
+    cavity (``inside`` tests the cavity), not on its rim."""
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
+    cavity = world.asset(target).cavity
+    centre = world.to_world(target, cavity.pose.position)
+    floor = float(centre[2]) - float(getattr(cavity, "half_length", 0.0))
+    yield from place(world, style, arm, obj, np.array([centre[0], centre[1], floor]))
+    yield from retreat_home(world, style, arm)
 
 
 def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan:

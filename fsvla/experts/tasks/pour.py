@@ -8,9 +8,12 @@ from fsvla.compiler.pose import axis_angle_matrix
 
 from .. import grasps
 from ..motion import Pose, Segment
-from ..skills import Plan, horizontal, nearest_arm, pick, place, transit
+from ..skills import Plan, horizontal, load_reach, nearest_arm, pick, place, transit
 from ..style import Style
 from ..world import World
+
+#: How high (m) above the target's top the held object's bottom is carried to pour.
+POUR_CLEARANCE = 0.04
 
 
 def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
@@ -20,14 +23,22 @@ def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
     grasp = grasps.choose(world, style, arm, obj)
     start = world.body_pose(obj).p.copy()
     yield from pick(world, style, arm, obj, grasp)
-    over = world.body_pose(target).p + np.array([0.0, 0.0, world.bounds(target)[1][2] + 0.12])
+    # the held object's centre (not the hand) over the target's mouth, and the tilt about
+    # that centre: a mug held by its handle swings wide of the target when the hand tilts
     tcp = world.current_pose(arm)
-    yield from transit(world, style, arm, Pose(over, tcp.R), below=0.15, exclude=(obj, target))
-    axis = horizontal(world.base_position(arm) - over)
+    lo, hi = world.bounds(obj)
+    held = tcp.p - 0.5 * (lo + hi)  # the hand from the object's centre
+    target_xy = world.body_pose(target).p
+    centre = np.array([target_xy[0], target_xy[1],
+                       world.bounds(target)[1][2] + 0.5 * (hi - lo)[2] + POUR_CLEARANCE])
+    over = Pose(centre + held, tcp.R)
+    yield from transit(world, style, arm, over, below=float(held[2]) + 0.5 * float((hi - lo)[2]),
+                       exclude=(obj, target), around=load_reach(world, arm, obj))
+    axis = horizontal(world.base_position(arm) - centre)
     tilt = axis_angle_matrix(axis, np.deg2rad(100))
-    yield Segment({arm: Pose(over, tilt @ tcp.R)}, speed=style.approach_speed, settle=20,
-                  label="pour")
-    yield Segment({arm: Pose(over, tcp.R)}, speed=style.approach_speed, label="unpour")
+    yield Segment({arm: Pose(centre + tilt @ held, tilt @ tcp.R)}, speed=style.approach_speed,
+                  settle=20, label="pour")
+    yield Segment({arm: over}, speed=style.approach_speed, label="unpour")
     yield from place(world, style, arm, obj, start)
 
 
