@@ -1,12 +1,14 @@
 """The pictures an attack optimises over: expectation over transformations (EOT).
 
 :func:`attack_views` renders the first observation of a few layouts (L1 seeds) of a
-scenario without the patch, with the patch's quad placed as V4 places it
-(:func:`fsvla.variation.patch.mount_patch`), and projects the quad into every camera that
-sees it. Each layout then gives ``transforms`` views: a change of light (a global gain on
-the picture, patch included) and a small camera jitter (the projected corners shifted by a
-few pixels), both drawn from the seed. Light and jitter are image-space approximations of
-V1/V3-like changes, so a layout is rendered once, and the patch is composited
+scenario as a V4 episode of that seed sees it, less the patch: vision levels are
+cumulative, so that is the V3 perturbation (light, colours, camera shift, occluder) of the
+same seed. The patch's quad is placed as V4 places it
+(:func:`fsvla.variation.patch.mount_patch`) and projected into every camera that sees it,
+through the cameras as V3 moved them. Each layout then gives ``transforms`` views, each
+with a further change of light (a global gain on the picture, patch included) and a small
+camera jitter (the projected corners shifted by a few pixels), drawn from the seed: these
+two are image-space, so a layout is rendered once, and the patch is composited
 (:mod:`fsvla.attack.warp`) rather than re-rendered at every query.
 """
 
@@ -73,8 +75,9 @@ def attack_views(scenario: str, *, target: str | None, size: float | None, layou
     rng = np.random.default_rng(seed)
     views: list[View] = []
     for layout in range(layouts):
+        # V3 is V4 without its patch: the same light, colours, camera shift and occluder
         env = FsvlaEnv(source, level="L1", seed=layout, embodiment=embodiment, obs_mode="rgb",
-                       resolution=resolution, monitor=False)
+                       vision="V3", resolution=resolution, monitor=False)
         try:
             if not env.cameras:
                 raise AttackInputError(f"{source.name}: the scene has no camera, so a policy "
