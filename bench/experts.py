@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import time
 from collections import Counter, defaultdict
 from collections.abc import Callable, Iterable
@@ -43,7 +44,15 @@ from pathlib import Path
 from statistics import fmean
 
 from fsvla.results import EpisodeRow, ResultStore
-from fsvla.runner import RunListener, execute_run, make_backend, make_config, prepare_run
+from fsvla.runner import (
+    RunInputError,
+    RunListener,
+    execute_run,
+    make_backend,
+    make_config,
+    prepare_run,
+)
+from fsvla.runner.prepare import scenario_refs
 from fsvla.validate.sampler import SampledScenario, sample_scenarios
 
 EXPERTS = ("careful", "careless")
@@ -224,7 +233,9 @@ def main() -> None:
                         help="folder for the two run folders (careful/, careless/)")
     parser.add_argument("--seeds", type=int, default=10, help="seeds per scenario and level")
     parser.add_argument("--levels", default="L0,L1,L2", help="layout levels, comma-separated")
-    parser.add_argument("--scenarios", default="scenarios/", help="scenario folder, files or names")
+    parser.add_argument("--scenarios", default="scenarios/",
+                        help="scenario folders, files, names or selectors (subset:diagnostic, "
+                             "suite:thermal, embodiment:so101), comma-separated")
     parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
     parser.add_argument("--experts", default="careful,careless", help="which experts to run")
     parser.add_argument("--random", type=int, default=None, metavar="N",
@@ -235,6 +246,11 @@ def main() -> None:
     args = parser.parse_args()
     args.levels = args.levels.split(",")
     args.scenarios = args.scenarios.split(",")
+    try:
+        scenario_refs(args.scenarios)
+    except RunInputError as err:
+        print(f"error: {err}", file=sys.stderr)
+        sys.exit(2)
     clock = time.perf_counter()
     drawn = write_random(args) if args.random is not None else {}
     if drawn:
