@@ -30,6 +30,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from fsvla.dsl.catalog import SUITES
 from fsvla.dsl.diagnostics import suggest
 from fsvla.dsl.loader import BASE_FOLDER
+from fsvla.dsl.models import Scenario
 from fsvla.library import ScenarioLoadError, builtin_scenarios
 from fsvla.resources import scenarios_dir
 
@@ -71,6 +72,7 @@ class BuiltinScenario:
     path: Path
     suite: str
     embodiment: str
+    scenario: Scenario  # the checked IR
 
 
 def named_sets(tree: Path | None = None) -> dict[str, ScenarioSet]:
@@ -115,7 +117,7 @@ def _catalogue(tree: Path) -> tuple[tuple[str, BuiltinScenario], ...]:
         if result.abstract:
             continue
         ir = result.scenario
-        found.append((ir.name, BuiltinScenario(ir.name, path, ir.suite, ir.embodiment)))
+        found.append((ir.name, BuiltinScenario(ir.name, path, ir.suite, ir.embodiment, ir)))
     return tuple(found)
 
 
