@@ -11,7 +11,6 @@ it with the checked-in one. ``docs/scenarios/generate.py`` writes the page, runs
 from __future__ import annotations
 
 import json
-import os
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -21,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from fsvla.dsl.catalog import EMBODIMENTS, SUITES
 from fsvla.dsl.models import Scenario
+from fsvla.resources import scenarios_dir
 
 Property = Literal["solvable", "hazardous", "starts_safe"]
 #: Where thumbnails lie, relative to the page's folder.
@@ -286,13 +286,15 @@ def builtin_scenarios_checked(tree: Path | None = None) -> list[tuple[Scenario, 
     return [(item.scenario, item.path) for item in builtin_catalogue(tree).values()]
 
 
-def catalogue_page(docs: Path, record: ValidateRecord, tree: Path | None = None) -> str:
-    """The catalogue page that belongs in ``docs/scenarios.md`` (``docs``: that folder)
-    for the scenarios of ``tree`` (default: the built-in tree) and ``record``."""
+def catalogue_page(record: ValidateRecord, tree: Path | None = None) -> str:
+    """The catalogue page that belongs in ``docs/scenarios.md`` for the scenarios of
+    ``tree`` (default: the built-in tree) and ``record``."""
     from fsvla.selectors import named_sets
 
     sets = named_sets(tree)
-    scenarios = [(scenario, Path(os.path.relpath(path, docs)).as_posix())
+    root = tree or scenarios_dir()
+    # links as the repository lays it out (docs/ beside scenarios/), wherever fsvla is installed
+    scenarios = [(scenario, f"../scenarios/{path.relative_to(root).as_posix()}")
                  for scenario, path in builtin_scenarios_checked(tree)]
     rows = catalogue_rows(scenarios, {n: s.scenarios for n, s in sets.items()}, record)
     return render_markdown(rows, {n: s.description for n, s in sets.items()}, record)

@@ -26,7 +26,7 @@ RECORD = DOCS / "scenarios" / "validate.json"
 
 
 def test_the_checked_in_catalogue_is_current() -> None:
-    expected = catalogue_page(DOCS, load_record(RECORD))
+    expected = catalogue_page(load_record(RECORD))
     current = PAGE.read_text(encoding="utf-8") if PAGE.is_file() else ""
     assert current == expected, (
         f"{PAGE.relative_to(DOCS.parent)} is not current for the scenarios, "

@@ -42,7 +42,7 @@ THUMB_SIZE = (160, 120)
 def write_page() -> None:
     from fsvla.catalogue import catalogue_page, load_record
 
-    PAGE.write_text(catalogue_page(PAGE.parent, load_record(RECORD)), encoding="utf-8")
+    PAGE.write_text(catalogue_page(load_record(RECORD)), encoding="utf-8")
     print(f"wrote {PAGE.relative_to(ROOT)}")
 
 
