@@ -59,6 +59,7 @@ class ValidateRun(_Model):
     recorded: str  # ISO date
     wall_s: float
     commit: str | None = None  # the repository's HEAD when it ran (the tree may have differed)
+    findings: tuple[str, ...] = ()  # its diagnostics, one line each (why a verdict failed)
 
 
 class RecordedScenario(_Model):
@@ -239,13 +240,17 @@ def _counts(values: Iterable[str], known: Sequence[str]) -> list[tuple[str, int]
 
 def _runs(record: ValidateRecord) -> list[str]:
     if not record.runs:
-        return ["No rates recorded yet: run `python docs/scenarios/generate.py --validate`."]
+        return [f"No rates recorded yet: run `{REGENERATE} --validate`."]
     lines = ["| run | command | layout seeds | recorded | wall time | commit |",
              "|---|---|---|---|---|---|"]
     for index, run in enumerate(record.runs, start=1):
         seeds = ", ".join(str(s) for s in run.seeds)
         lines.append(f"| {index} | `{run.command}` | {seeds} | {run.recorded} | "
                      f"{run.wall_s / 60:.0f} min | {(run.commit or '—')[:10]} |")
+    for index, run in enumerate(record.runs, start=1):
+        if run.findings:
+            lines += ["", f"What run {index} said of its failed verdicts and static checks:", "",
+                      *(f"- {finding}" for finding in run.findings)]
     return lines
 
 
@@ -262,6 +267,19 @@ def _row(row: CatalogueRow, several_runs: bool) -> str:
              "<br>".join(row.hazards) or "—", "<br>".join(row.channels) or "—",
              ", ".join(row.sets) or "—", *rates]
     return "| " + " | ".join(cells) + " |"
+
+
+def findings(output: Mapping[str, object]) -> tuple[str, ...]:
+    """The diagnostics of ``fsvla validate --format json`` output, one line each:
+    ``file:line: CODE message (notes)``."""
+    items = output.get("diagnostics", [])
+    lines = []
+    for item in items if isinstance(items, list) else []:
+        span = item.get("span") or {}
+        notes = "; ".join(item.get("notes") or ())
+        lines.append(f"`{span.get('file')}:{span.get('line')}` {item.get('code')} "
+                     f"{item.get('message')}" + (f" ({notes})" if notes else ""))
+    return tuple(lines)
 
 
 def load_record(path: Path) -> ValidateRecord:
@@ -302,4 +320,5 @@ def catalogue_page(record: ValidateRecord, tree: Path | None = None) -> str:
 
 __all__ = ["RATE_COLUMNS", "REGENERATE", "THUMBS", "CatalogueRow", "RecordedScenario",
            "RecordedVerdict", "ValidateRecord", "ValidateRun", "builtin_scenarios_checked",
-           "catalogue_page", "catalogue_rows", "load_record", "render_markdown", "write_record"]
+           "catalogue_page", "catalogue_rows", "findings", "load_record", "render_markdown",
+           "write_record"]

@@ -15,6 +15,7 @@ from fsvla.catalogue import (
     builtin_scenarios_checked,
     catalogue_page,
     catalogue_rows,
+    findings,
     load_record,
     render_markdown,
 )
@@ -62,7 +63,9 @@ def _verdicts(name: str, careful_l1: int) -> dict:
             {"scenario": name, "level": level, "verdict": "starts_safe", "count": 2,
              "episodes": 2, "needed": 1.0, "holds": True},
         ]
-    return {"verdicts": items, "diagnostics": [], "runs": {}}
+    diagnostic = {"code": "FSV712", "severity": "error", "message": "crossed `grip`",
+                  "span": {"file": "a.fsv", "line": 3, "column": 2}, "notes": ["in 2 of 2"]}
+    return {"verdicts": items, "diagnostics": [diagnostic] if careful_l1 < 2 else [], "runs": {}}
 
 
 def test_rows_rates_and_records() -> None:
@@ -70,9 +73,10 @@ def test_rows_rates_and_records() -> None:
     stove = loader.load(scenarios_dir() / "thermal" / "lift_pot_beside_stove.fsv").scenario
     glass = loader.load(scenarios_dir() / "force" / "place_glass_on_shelf.fsv").scenario
     assert stove is not None and glass is not None
+    output = _verdicts(stove.name, 0)
     run = ValidateRun(command="fsvla validate x", levels=("L0", "L1", "L2"), seeds=(0, 1),
-                      recorded="2026-01-01", wall_s=60)
-    record = ValidateRecord().merged(run, _verdicts(stove.name, 0), {stove.name: "old"})
+                      recorded="2026-01-01", wall_s=60, findings=findings(output))
+    record = ValidateRecord().merged(run, output, {stove.name: "old"})
     rows = catalogue_rows([(stove, "a.fsv"), (glass, "b.fsv")], {"demo": [stove.name]}, record)
     assert [r.name for r in rows] == [glass.name, stove.name]  # force before thermal
     glass_row, stove_row = rows
@@ -85,6 +89,7 @@ def test_rows_rates_and_records() -> None:
     page = render_markdown(rows, {"demo": "a set"}, record)
     assert "| no rates recorded |" in page and "| 2/2 † | 2/4 ✗ † |" in page
     assert "| 1 | `fsvla validate x` | 0, 1 | 2026-01-01 | 1 min |" in page
+    assert "- `a.fsv:3` FSV712 crossed `grip` (in 2 of 2)" in page
     # a second run over the same scenario replaces it, and the first run is dropped
     again = record.merged(run.model_copy(update={"seeds": (0, 1, 2)}),
                           _verdicts(stove.name, 2), {stove.name: stove.source_digest})

@@ -81,14 +81,15 @@ def run_validate(items: list[str], levels: str, seeds: int, workers: int, out: P
 
 def record(output: dict, command: str, levels: str, seeds: int, wall_s: float,
            commit: str | None = None) -> None:
-    from fsvla.catalogue import ValidateRun, load_record, write_record
+    from fsvla.catalogue import ValidateRun, findings, load_record, write_record
     from fsvla.catalogue import builtin_scenarios_checked as checked
     from fsvla.run import parse_levels
 
     commit = commit or subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
                                       text=True, check=False).stdout.strip() or None
     run = ValidateRun(command=command, levels=parse_levels(levels), seeds=tuple(range(seeds)),
-                      recorded=date.today().isoformat(), wall_s=round(wall_s), commit=commit)
+                      recorded=date.today().isoformat(), wall_s=round(wall_s), commit=commit,
+                      findings=findings(output))
     digests = {scenario.name: scenario.source_digest for scenario, _path in checked()}
     write_record(load_record(RECORD).merged(run, output, digests), RECORD)
     print(f"recorded {len(output.get('verdicts', []))} verdicts in {RECORD.relative_to(ROOT)}")
