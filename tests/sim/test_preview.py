@@ -139,3 +139,17 @@ def test_preview_without_device_fails_cleanly(tmp_path: Path) -> None:
     assert "no Vulkan rendering device" in done.stderr and ".ci/install-vulkan" in done.stderr
     assert "Traceback" not in done.stderr + done.stdout
     assert not (tmp_path / "p.png").exists()
+
+
+@pytest.mark.sim
+@pytest.mark.render
+def test_preview_one_view_by_built_in_name(render_device, tmp_path: Path, capsys) -> None:
+    """`--view` writes that view alone, at the camera's size; a scenario may be named."""
+    from PIL import Image
+
+    out = tmp_path / "front.png"
+    assert run(["preview", STOVE.stem, "--view", "front", "-o", str(out)]) == 0
+    assert Image.open(out).size == (320, 240)
+    assert run(["preview", STOVE.stem, "--view", "side", "-o", str(tmp_path / "x.png")]) == 1
+    assert "its views: front, left_wrist, right_wrist, top" in capsys.readouterr().err
+    assert run(["preview", "suite:thermal", "-o", str(tmp_path / "y.png")]) == 2
