@@ -98,18 +98,22 @@ def named_sets(tree: Path | None = None) -> dict[str, ScenarioSet]:
 
 
 def builtin_catalogue(tree: Path | None = None) -> dict[str, BuiltinScenario]:
-    """Every concrete scenario of ``tree`` (default: the built-in tree) by name, with its
-    suite and embodiment; a file that does not check raises."""
-    return dict(_catalogue(tree or scenarios_dir()))
+    """Every concrete scenario of ``tree`` (default: the built-in tree) by name (its file's
+    stem, as built-in names go), with its suite and embodiment; a file that does not check
+    raises. Kept while no ``.fsv`` file of the tree changes."""
+    tree = tree or scenarios_dir()
+    stamp = tuple((str(p), p.stat().st_mtime_ns) for p in sorted(tree.rglob("*.fsv")))
+    return dict(_catalogue(tree, stamp))
 
 
 @lru_cache(maxsize=4)
-def _catalogue(tree: Path) -> tuple[tuple[str, BuiltinScenario], ...]:
+def _catalogue(tree: Path, _stamp: tuple[tuple[str, int], ...]) -> tuple[
+        tuple[str, BuiltinScenario], ...]:
     from fsvla.dsl.loader import ScenarioLoader
 
     loader = ScenarioLoader(allowed_roots=[tree])
     found = []
-    for path in _tree_files(tree).values():
+    for stem, path in _tree_files(tree).items():
         result = loader.load(path)
         if not result.ok or result.scenario is None:
             raise ScenarioSelectionError("scenario", f"{path}: the scenario does not check "
@@ -117,7 +121,7 @@ def _catalogue(tree: Path) -> tuple[tuple[str, BuiltinScenario], ...]:
         if result.abstract:
             continue
         ir = result.scenario
-        found.append((ir.name, BuiltinScenario(ir.name, path, ir.suite, ir.embodiment, ir)))
+        found.append((stem, BuiltinScenario(stem, path, ir.suite, ir.embodiment, ir)))
     return tuple(found)
 
 
@@ -126,12 +130,6 @@ def _tree_files(tree: Path) -> dict[str, Path]:
         return builtin_scenarios()
     return {p.stem: p for p in sorted(tree.rglob("*.fsv"))
             if BASE_FOLDER not in p.relative_to(tree).parts}
-
-
-def is_selector(item: str) -> bool:
-    """Whether ``item`` is written as a selector (``kind:value``) rather than a path."""
-    kind, colon, _ = item.partition(":")
-    return bool(colon) and kind in KINDS and not Path(item).exists()
 
 
 def select(kind: str, value: str, tree: Path | None = None) -> list[str]:
@@ -258,5 +256,5 @@ def _resolve_one(item: str, bases: bool, tree: Path, builtin: Mapping[str, Path]
 
 
 __all__ = ["KINDS", "SETS_FILE", "BuiltinScenario", "ScenarioSelectionError", "ScenarioSet",
-           "builtin_catalogue", "is_selector", "named_sets", "resolve_scenarios",
+           "builtin_catalogue", "named_sets", "resolve_scenarios",
            "scenario_paths", "select"]
