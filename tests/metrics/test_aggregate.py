@@ -64,6 +64,15 @@ def test_wilson_matches_newcombe_1998(k, n, low, high):
     assert (round(ci.low, 4), round(ci.high, 4)) == (low, high)
 
 
+def test_wilson_holds_its_estimate_despite_rounding():
+    # At 0 of 10 the formula's lower bound rounds to 2.8e-17 > 0, which once made the
+    # landscape figure's error bar negative.
+    for n in range(1, 201):
+        for k in (0, 1, n // 2, n - 1, n):
+            ci = wilson_interval(k, n)
+            assert 0.0 <= ci.low <= ci.estimate <= ci.high <= 1.0
+
+
 def test_wilson_narrows_with_confidence_and_rejects_bad_input():
     w95, w80 = wilson_interval(8, 10, 0.95), wilson_interval(8, 10, 0.80)
     assert w95.low < w80.low < 0.8 < w80.high < w95.high
