@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -43,9 +43,12 @@ class CollectProgress:
 
 def collect(scenario: ScenarioRef, out: Path, episodes: int, *, level: str = "L0",
             images: bool = True, max_attempts: int | None = None,
+            cameras: Sequence[str] | None = None, resolution: str | None = None,
             on_attempt: Callable[[CollectProgress], None] | None = None) -> CollectProgress:
     """Collect until ``out`` holds ``episodes`` kept episodes or ``max_attempts`` (default
-    three per wanted episode) attempts have been made in all; returns the progress."""
+    three per wanted episode) attempts have been made in all; returns the progress.
+    ``cameras`` (names; None: all) and ``resolution`` (``"WIDTHxHEIGHT"``; None: each
+    camera's own) choose the pictures recorded."""
     from fsvla.env import make
     from fsvla.experts import make_expert
 
@@ -56,7 +59,8 @@ def collect(scenario: ScenarioRef, out: Path, episodes: int, *, level: str = "L0
     writer: LeRobotWriter | None = None
     obs_mode = "rgb" if images else "state"
     while progress.kept < episodes and progress.attempts < limit:
-        env = make(source, level=level, seed=progress.next_seed, obs_mode=obs_mode)
+        env = make(source, level=level, seed=progress.next_seed, obs_mode=obs_mode,
+                   cameras=cameras, resolution=resolution)
         if writer is None:
             writer = _writer(out, env)
             progress.kept = writer.episodes
@@ -107,7 +111,7 @@ def _writer(out: Path, env) -> LeRobotWriter:  # noqa: ANN001
     arms = [arm.name for arm in codec.arms]
     state = [f"{a.name}.{j}" for a in codec.arms for j in a.joints] + [f"{a}.gripper" for a in arms]
     tcp = [f"{a}.{c}" for a in arms for c in ("x", "y", "z", "qw", "qx", "qy", "qz")]
-    cameras = ({c.name: (c.height, c.width) for c in env.scene_spec.cameras}
+    cameras = ({c.name: (c.height, c.width) for c in env.render_spec.cameras}
                if env.config.obs_mode == "rgb" else {})
     fps = 1.0 / env.control_dt
     return LeRobotWriter(out, fps=fps, robot_type=env.config.embodiment,

@@ -21,8 +21,14 @@ from rich.console import Console
               help="Give up after this many attempts in all (default: 3 per episode).")
 @click.option("--state-only", is_flag=True,
               help="No camera videos (no render device needed).")
+@click.option("--cameras", metavar="NAMES", default=None,
+              help="The cameras recorded, comma-separated, e.g. front,wrist. Default: all of "
+                   "the embodiment's.")
+@click.option("--resolution", metavar="WIDTHxHEIGHT", default=None,
+              help="Every recorded camera's resolution, e.g. 128x96. Default: each camera's own.")
 def collect_command(scenario: str, episodes: int, level: str, out_dir: Path,
-                    max_attempts: int | None, state_only: bool) -> None:
+                    max_attempts: int | None, state_only: bool, cameras: str | None,
+                    resolution: str | None) -> None:
     """Record the careful expert's safe, successful episodes of SCENARIO (a built-in name
     or a .fsv file) as a LeRobot dataset: multi-view video, state, action and instruction
     per frame."""
@@ -40,6 +46,8 @@ def collect_command(scenario: str, episodes: int, level: str, out_dir: Path,
             task = bar.add_task("collect", total=episodes, attempts=0)
             progress = collect(scenario, out_dir, episodes, level=level, images=not state_only,
                                max_attempts=max_attempts,
+                               cameras=cameras.split(",") if cameras else None,
+                               resolution=resolution,
                                on_attempt=lambda p: bar.update(task, completed=p.kept,
                                                                attempts=p.attempts))
     except (ScenarioLoadError, DatasetMismatch, ValueError) as err:
