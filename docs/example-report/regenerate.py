@@ -1,6 +1,8 @@
-"""Regenerate the example report in this folder from a real run of both scripted experts.
+"""Regenerate the example report in this folder from a real run of both scripted experts,
+and of the trained baseline where its run exists.
 
     python docs/example-report/regenerate.py [--runs runs/example-report] [--workers 2]
+                                             [--baseline runs/baseline/eval]
 
 What it runs, as a user would (every step is a plain ``fsvla`` command, printed first):
 
@@ -18,6 +20,11 @@ What it runs, as a user would (every step is a plain ``fsvla`` command, printed 
 3. ``fsvla replay --video`` of that episode into its run's ``videos/`` folder, so the
    dissection shows keyframes;
 4. ``fsvla report`` into this folder: HTML, Markdown, LaTeX, JSON, PNG figures, CSV.
+
+The baseline's run folder (``bench/baseline.py`` writes it: an ACT trained on the careful
+expert's demonstrations, reading the front camera's pictures; see docs/baseline.md) is
+reported beside the experts as a third policy, ``act-baseline``, when it exists; it is
+not run from here (its training takes up to 45 minutes).
 
 Runs resume, so an interrupted regeneration picks up where it stopped.
 """
@@ -39,6 +46,7 @@ GRID = ["--scenarios", "scenarios/", "--sweep", "--obs-mode", "rgb", "--warmup",
 PER_EXPERT = {"careful-expert": ["--episodes", "3"],
               "careless-expert": ["--episodes", "1", "--terminate-on-violation"]}
 FORMATS = "html,md,json,tex,png,csv"
+BASELINE = "act-baseline"
 
 
 def fsvla(*args: str) -> None:
@@ -52,20 +60,26 @@ def main() -> None:
     parser.add_argument("--runs", type=Path, default=Path("runs/example-report"),
                         help="where the two run folders go (relative to the repository)")
     parser.add_argument("--workers", default="2", help="worker processes for each run")
+    parser.add_argument("--baseline", type=Path, default=Path("runs/baseline/eval"),
+                        help="the trained baseline's run folder (bench/baseline.py), "
+                             "reported when it exists")
     args = parser.parse_args()
     folders = {expert: args.runs / expert.split("-")[0] for expert in EXPERTS}
     for expert, folder in folders.items():
         fsvla("run", "--policy", expert, *GRID, *PER_EXPERT[expert], "--workers", args.workers,
               "--out", str(folder), "--no-progress")
-    runs = [str(folders[e]) for e in EXPERTS]
+    if (ROOT / args.baseline / "results.sqlite").exists():
+        folders[BASELINE] = args.baseline
+    runs = [str(f) for f in folders.values()]
+    labels = [arg for label in folders for arg in ("--label", label)]
     with tempfile.TemporaryDirectory(prefix="fsvla-example-") as scratch:
-        fsvla("report", *runs, "-o", scratch, "--formats", "json", "--no-figures")
+        fsvla("report", *runs, *labels, "-o", scratch, "--formats", "json", "--no-figures")
         chosen = json.loads((Path(scratch) / "report.json").read_text())["dissection"]
     folder = folders[chosen["label"]]
     video = folder / "videos" / f"{chosen['episode_id']}.mp4"
     if not (ROOT / video).exists():
         fsvla("replay", str(folder), chosen["episode_id"], "--video", str(video))
-    fsvla("report", *runs, "-o", str(HERE.relative_to(ROOT)), "--formats", FORMATS)
+    fsvla("report", *runs, *labels, "-o", str(HERE.relative_to(ROOT)), "--formats", FORMATS)
 
 
 if __name__ == "__main__":
