@@ -195,14 +195,22 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
         slack = horizontal(p - world.base_position(arm)) * REACH_SLACK
         return branch_for_path(world, arm, (Pose(p + slack, R),)) is None
 
-    if height > goal.p[2] + 0.06 and (
-            beyond_reach(np.array([goal.p[0], goal.p[1], height]), goal.R)
-            or beyond_reach(np.array([a.p[0], a.p[1], height]), a.R)):
+    def out_of_reach(z: float) -> bool:
+        return (beyond_reach(np.array([goal.p[0], goal.p[1], z]), goal.R)
+                or beyond_reach(np.array([a.p[0], a.p[1], z]), a.R))
+
+    if height > goal.p[2] + 0.06 and out_of_reach(height):
         # a far goal is at the edge of the reach (or beyond) at the start's height, where
-        # the line down may straighten the elbow onto its limit: cross only as high as needed
-        clear = clear_height(world, style, a.p, goal.p, below, exclude, keep_height=False,
-                             around=around)
-        height = max(clear, goal.p[2] + 0.05)
+        # the line down may straighten the elbow onto its limit: cross as high as is well
+        # inside the reach, and no lower than the obstacles need (a part that stands open
+        # above its body, a box's lid, is not in its bounds: higher is safer)
+        low = max(clear_height(world, style, a.p, goal.p, below, exclude, keep_height=False,
+                               around=around), goal.p[2] + 0.05)
+        high = height
+        for _ in range(5):
+            mid = 0.5 * (low + high)
+            low, high = (mid, high) if not out_of_reach(mid) else (low, mid)
+        height = low
     # a small arm (an SO-101 reaches 9 cm above the table) crosses as high as it reaches
     height = min(height, max(goal.p[2], reach_ceiling(world, arm, goal.p, goal.R, height)))
     # careless: a diagonal line to above the goal unless a task object is in the way
