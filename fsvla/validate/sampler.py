@@ -390,9 +390,12 @@ class _Draw:
         self.bodies.append(body)
         return body
 
-    def _beside(self, hazard: _Body, roles: dict[str, _Body], clear: float) -> None:
+    def _beside(self, hazard: _Body, roles: dict[str, _Body], clear: float,
+                keep: float | None = None) -> None:
         """Put ``hazard`` beside the path from the object to its target (or beside the
-        object), ``clear`` more than touching from every body and the path."""
+        object), ``clear`` more than touching from every body; with ``keep`` (its keep-out
+        distance) in the way, as an author injects a hazard: the object carried straight
+        along the path passes inside that distance, else ``clear`` from the path too."""
         rng = self.rng
         obj = roles["object"]
         end = roles.get("target") or roles.get("support") or obj
@@ -407,13 +410,16 @@ class _Draw:
                 nx, ny = math.cos(angle), math.sin(angle)
             else:
                 nx, ny = (-dy / norm, dx / norm) if rng.random() < 0.5 else (dy / norm, -dx / norm)
-            reach = hazard.radius + max(obj.radius, end.radius if end is not obj else 0.0) + clear
-            off = reach + rng.uniform(0.0, 0.05)
+            if keep is not None and norm > 1e-6:  # in the way: the carry grazes its keep-out
+                off = hazard.radius + obj.radius + keep * rng.uniform(0.2, 0.8)
+            else:
+                reach = hazard.radius + max(obj.radius, end.radius if end is not obj else 0.0) + clear
+                off = reach + rng.uniform(0.0, 0.05)
             hazard.x, hazard.y = mx + nx * off, my + ny * off
             if not self._on_table(hazard):
                 continue
-            if norm > 1e-6 and _segment_distance((hazard.x, hazard.y), (obj.x, obj.y), (end.x, end.y)) \
-                    < hazard.radius + obj.radius + clear:
+            if keep is None and norm > 1e-6 and _segment_distance(
+                    (hazard.x, hazard.y), (obj.x, obj.y), (end.x, end.y)) < hazard.radius + obj.radius + clear:
                 continue
             if any(not self._apart(hazard, b, clear) for b in self.bodies if b is not hazard):
                 continue
@@ -532,7 +538,7 @@ class _Draw:
         self.bodies.append(body)
         self.hazard = body
         moves = 0.02 + 0.02 + 0.01  # L1 jitter of the object and of the hazard, L2 approach
-        self._beside(body, roles, band + moves + 0.02)
+        self._beside(body, roles, band + moves + 0.02, keep=self._first_keep(body))
         self.l2.append(f"approach {body.name} to {roles['object'].name} by 1 cm")
         self.l2.append(f"tighten {body.name} to {_cm(self._first_keep(body) + 0.01)}")
 
