@@ -232,12 +232,13 @@ def parameters(safetensors: Path) -> int:
 
 
 def evaluate(args: argparse.Namespace, scenarios: list[str]) -> None:
+    # --extend: a run of fewer cells (--cells vision) grows to these; a new one starts
     grid = {"sweep": ["--sweep"], "vision": ["--vision", "V0-V4"], "L0": []}[args.cells]
     run(BIN / "fsvla", "run", "--policy", "bench/baseline.py:Baseline",
         "--scenarios", ",".join(scenarios), *grid, "--obs-mode", "rgb", "--cameras",
         args.cameras, "--resolution", args.resolution, "--episodes", str(args.eval_episodes),
         "--warmup", "0", "--workers", str(args.workers), "--out", args.out / "eval",
-        "--no-progress", env=dict(tool_env(args.out / "data", threads=1),
+        "--extend", "--no-progress", env=dict(tool_env(args.out / "data", threads=1),
                                   **{ENV_OUT: str(args.out.resolve())}))
     run(BIN / "fsvla", "report", args.out / "eval", "-o", args.out / "report", "--formats",
         "json,md,csv", "--no-figures", "--label", "act-baseline")
@@ -341,7 +342,7 @@ def main(argv: list[str] | None = None) -> None:
 
     start = time.monotonic()
     evaluate(args, [s for g in groups.values() for s in g])
-    timings["evaluate"] = round(time.monotonic() - start, 1)
+    timings["evaluate"] = round(timings.get("evaluate", 0.0) + time.monotonic() - start, 1)
     summary["per_cell"] = per_cell(args.out / "report" / "data" / "episodes.csv")
     print_cells(summary["per_cell"])
     summary_path.write_text(json.dumps(summary, indent=2))
