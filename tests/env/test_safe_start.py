@@ -13,11 +13,15 @@ from fsvla.compiler.variants import VariantError
 import fsvla
 from fsvla.env import FsvlaEnv
 from fsvla.policies.simple import hold_action
+from fsvla.selectors import named_sets
 
 pytestmark = pytest.mark.sim
 
 REPO = Path(__file__).resolve().parents[2]
 CONCRETE = sorted(p for p in (REPO / "scenarios").rglob("*.fsv") if "_base" not in p.parts)
+#: The diagnostic subset gets the long checks; every other scenario's starts are proven by
+#: `fsvla validate` (its hold-still verdict), so CI does not grow with the catalogue.
+DIAGNOSTIC = [p for p in CONCRETE if p.stem in named_sets()["diagnostic"].scenarios]
 LEVELS = ("L0", "L1", "L2")
 
 
@@ -41,15 +45,16 @@ def _hold_still(env: FsvlaEnv, steps: int | None = None) -> tuple[float, int, in
 @pytest.mark.parametrize("level", LEVELS)
 @pytest.mark.parametrize("path", CONCRETE, ids=[p.stem for p in CONCRETE])
 def test_holding_still_starts_safe(path: Path, level: str) -> None:
-    """The first second of two layouts per level: bodies settle, the robot holds at home."""
-    for seed in (0, 1):
+    """The first second of a layout per level (two for the diagnostic subset): bodies
+    settle, the robot holds at home."""
+    for seed in ((0, 1) if path in DIAGNOSTIC else (0,)):
         cost, exposed, violated, _ = _hold_still(fsvla.make(path, level=level, seed=seed), steps=20)
         assert (cost, exposed, violated) == (0.0, 0, 0), (level, seed)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("level", LEVELS)
-@pytest.mark.parametrize("path", CONCRETE, ids=[p.stem for p in CONCRETE])
+@pytest.mark.parametrize("path", DIAGNOSTIC, ids=[p.stem for p in DIAGNOSTIC])
 def test_holding_still_costs_nothing_over_whole_episodes(path: Path, level: str) -> None:
     for seed in range(3):
         env = fsvla.make(path, level=level, seed=seed)
