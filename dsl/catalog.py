@@ -339,10 +339,27 @@ def default_params(params: tuple[Param, ...]) -> dict[str, Value]:
 
 
 __all__ = [
+    "ASSETS",
+    "BIMANUAL_TASKS",
     "COLOR_NAMES",
-    "ASSETS", "ZONES", "METRICS", "PREDICATES", "TASKS", "EMBODIMENTS", "SHAPINGS", "SUITES",
-    "ArgKind", "AssetClass", "AssetKind", "HazardRole", "Param", "Signature", "robot_parts",
-    "ZONE_CHANNEL", "ROLE_CHANNEL", "BIMANUAL_TASKS", "SIDE_EFFECTS", "default_params",
+    "EMBODIMENTS",
+    "METRICS",
+    "PREDICATES",
+    "ROLE_CHANNEL",
+    "SHAPINGS",
+    "SIDE_EFFECTS",
+    "SUITES",
+    "TASKS",
+    "ZONES",
+    "ZONE_CHANNEL",
+    "ArgKind",
+    "AssetClass",
+    "AssetKind",
+    "HazardRole",
+    "Param",
+    "Signature",
+    "default_params",
+    "robot_parts",
 ]
 
 

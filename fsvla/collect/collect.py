@@ -80,7 +80,7 @@ def collect(scenario: ScenarioRef, out: Path, episodes: int, *, level: str = "L0
     return progress
 
 
-def _attempt(env, expert) -> tuple[list[Frame], str | None]:  # noqa: ANN001
+def _attempt(env, expert) -> tuple[list[Frame], str | None]:
     """Run one episode; its frames, and why it is rejected (None: kept)."""
     obs, _ = env.reset()
     expert.reset(None)  # scripted experts plan from the bound env, not from EpisodeInfo
@@ -106,7 +106,7 @@ def _attempt(env, expert) -> tuple[list[Frame], str | None]:  # noqa: ANN001
     return frames, None
 
 
-def _writer(out: Path, env) -> LeRobotWriter:  # noqa: ANN001
+def _writer(out: Path, env) -> LeRobotWriter:
     codec = env.codec
     arms = [arm.name for arm in codec.arms]
     state = [f"{a.name}.{j}" for a in codec.arms for j in a.joints] + [f"{a}.gripper" for a in arms]
@@ -136,4 +136,4 @@ def _save_progress(out: Path, progress: CollectProgress) -> None:
     os.replace(temporary, path)
 
 
-__all__ = ["CollectProgress", "PROGRESS_FILE", "collect"]
+__all__ = ["PROGRESS_FILE", "CollectProgress", "collect"]

@@ -32,7 +32,13 @@ def collect_command(scenario: str, episodes: int, level: str, out_dir: Path,
     """Record the careful expert's safe, successful episodes of SCENARIO (a built-in name
     or a .fsv file) as a LeRobot dataset: multi-view video, state, action and instruction
     per frame."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeRemainingColumn,
+    )
 
     from fsvla.collect import DatasetMismatch, collect
     from fsvla.library import ScenarioLoadError
