@@ -112,8 +112,8 @@ class ArmModel(Protocol):
         ...
 
     def finger_points(self, fraction: float) -> NDArray[np.float64]:
-        """World positions (2, 3) of the points of the first two fingers that lie on the
-        TCP when the gripper is closed, with it open by ``fraction`` (the arm as it is)."""
+        """World positions (n, 3), one per finger link, of the points that lie on the TCP
+        when the gripper is closed, with it open by ``fraction`` (the arm as it is)."""
         ...
 
     def link_vertices(self, link: int) -> NDArray[np.float64] | None:

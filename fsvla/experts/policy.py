@@ -126,7 +126,6 @@ class ExpertPolicy:
                 self._stop_guarded()
                 continue
             steps.append(self._queue.popleft())
-            self._last = steps[-1]
             break
         if not steps:  # the plan is done: hold the last command
             steps = [self._last] if self._last is not None else [self._hold()]

@@ -156,7 +156,7 @@ class World:
             fingers = self.arm_spec(arm).gripper.finger_links
             if len(fingers) > 1:
                 R = quat_to_matrix(self.state.tcp_pose(arm).q)
-                a, b = self.kinematics(arm).finger_points(1.0)
+                a, b = self.kinematics(arm).finger_points(1.0)[:2]
                 axis = R.T @ (b - a)
             else:
                 axis = np.array([0.0, 1.0, 0.0])
@@ -180,7 +180,7 @@ class World:
             if len(self.arm_spec(arm).gripper.finger_links) < 2:
                 self._open_width[arm] = self.travel(arm)
             else:
-                a, b = self.kinematics(arm).finger_points(1.0)
+                a, b = self.kinematics(arm).finger_points(1.0)[:2]
                 self._open_width[arm] = float(np.linalg.norm(b - a))
         return self._open_width[arm]
 
@@ -195,9 +195,9 @@ class World:
         lo, hi = 0.0, 1.0
         for _ in range(14):  # the opening whose gap is ``width``
             mid = 0.5 * (lo + hi)
-            a, b = kin.finger_points(mid)
+            a, b = kin.finger_points(mid)[:2]
             lo, hi = (mid, hi) if np.linalg.norm(b - a) < width else (lo, mid)
-        a, b = kin.finger_points(hi)
+        a, b = kin.finger_points(hi)[:2]
         tcp = self.current_pose(arm)
         return tcp.R.T @ (0.5 * (a + b) - tcp.p)
 

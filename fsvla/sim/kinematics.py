@@ -78,11 +78,11 @@ class ArmKinematics:
                 np.array([pose.q for pose in poses]).reshape(-1, 4))
 
     def finger_points(self, fraction: float) -> NDArray[np.float64]:
-        """World positions (2, 3) of the points of the first two finger links that lie on
-        the TCP when the gripper is closed, with the gripper open by ``fraction`` and the
-        arm where it is: their distance is the opening at the TCP, their difference the
-        direction the fingers close along (the same measure ``fsvla validate`` takes)."""
-        fingers = self.arm.finger_links[:2]
+        """World positions (n, 3), one per finger link, of the points that lie on the TCP
+        when the gripper is closed, with the gripper open by ``fraction`` and the arm where
+        it is: their largest distance is the opening at the TCP (``fsvla validate``'s
+        measure), the first two's difference the direction the fingers close along."""
+        fingers = self.arm.finger_links
         links = self.arm.articulation.get_links()
         indices = [next(i for i, lk in enumerate(links) if lk.name == f.name) for f in fingers]
         root = self.arm.articulation.get_root_pose()

@@ -99,27 +99,7 @@ class RobotModel:
         return self._openings[arm]
 
     def _measure_opening(self, arm: str) -> float:
-        loaded = self.robot.arm(arm)
-        articulation = loaded.articulation
-        home = np.asarray(articulation.get_qpos(), dtype=np.float64)
-        gripper = loaded.spec.gripper
-
-        def pose_at(fraction: float) -> tuple[NDArray[np.float64], list[NDArray[np.float64]]]:
-            q = home.copy()
-            for index, lo, hi in zip(loaded.gripper_indices, gripper.closed, gripper.open):
-                q[index] = lo + fraction * (hi - lo)
-            articulation.set_qpos(q.astype(np.float32))
-            fingers = [np.asarray(f.entity_pose.to_transformation_matrix(), dtype=np.float64)
-                       for f in loaded.finger_links]
-            return np.asarray(loaded.tcp_pose().p, dtype=np.float64), fingers
-
-        try:
-            tcp, closed = pose_at(0.0)
-            held = [np.linalg.inv(m) @ np.append(tcp, 1.0) for m in closed]
-            _, opened = pose_at(1.0)
-        finally:
-            articulation.set_qpos(home.astype(np.float32))
-        points = [(m @ h)[:3] for m, h in zip(opened, held)]
+        points = self._kinematics[arm].finger_points(1.0)
         return max((float(np.linalg.norm(a - b)) for i, a in enumerate(points) for b in points[i + 1:]),
                    default=0.0)
 
