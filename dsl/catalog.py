@@ -74,6 +74,9 @@ def _size3(default: tuple[float, float, float], lo: float = 0.005, hi: float = 2
     return Param(name="size", dimension=Dimension.LENGTH, arity=3, default=default, minimum=lo, maximum=hi)
 
 
+#: How far an articulated body's part starts open: a fraction of its joint's range.
+_OPEN = Param(name="open", default=0.0, minimum=0.0, maximum=1.0,
+              doc="how far the part starts open, as a fraction of its range (0: shut, 1: fully open)")
 _MASS = Param(name="mass", dimension=Dimension.MASS, minimum=0.001, maximum=50.0,
               doc="overrides the mass computed from the asset's density")
 _FRICTION = Param(name="friction", default=0.6, minimum=0.0, maximum=2.0)
@@ -143,13 +146,13 @@ _ASSETS: list[AssetKind] = [
               params=(_size2((0.4, 0.25)), _length("height", 0.2, lo=0.02, hi=0.6), _FRICTION)),
     AssetKind(name="drawer_cabinet", asset_class=AssetClass.ARTICULATED, container=True, parts=("drawer",),
               doc="a cabinet with one sliding drawer (part `drawer`)",
-              params=(_size3((0.4, 0.35, 0.25)), _length("travel", 0.2, lo=0.05, hi=0.5))),
+              params=(_size3((0.4, 0.35, 0.25)), _length("travel", 0.2, lo=0.05, hi=0.5), _OPEN)),
     AssetKind(name="microwave", asset_class=AssetClass.ARTICULATED, container=True, parts=("door",),
               doc="a box with a hinged door (part `door`)",
-              params=(_size3((0.45, 0.35, 0.28)),)),
+              params=(_size3((0.45, 0.35, 0.28)), _OPEN)),
     AssetKind(name="lidded_box", asset_class=AssetClass.ARTICULATED, container=True, parts=("lid",),
               doc="a box with a hinged lid (part `lid`)",
-              params=(_size3((0.2, 0.15, 0.1)),)),
+              params=(_size3((0.2, 0.15, 0.1)), _OPEN)),
     AssetKind(name="mesh", asset_class=AssetClass.FILE,
               doc="a rigid body from a mesh file (.obj, .stl, .ply, .glb) next to the scenario",
               params=(Param(name="path", required=True, path=True, doc="relative to the .fsv file"),

@@ -264,6 +264,15 @@ class ArticulatedAsset(_Model):
             raise ValueError("an articulated asset needs exactly one of `urdf` and `urdf_path`")
         return self
 
+    def start_positions(self) -> dict[str, float]:
+        """The joint positions the body starts at (joint name -> rad or m): each part's
+        joint ``open`` (the asset's parameter, 0 when absent) of the way from its lower
+        limit to its upper; joints not named here start at 0."""
+        fraction = float(self.params.get("open", 0.0) or 0.0)
+        joints = {j.name: j for j in self.joints}
+        return {p.joint: joints[p.joint].lower + fraction * (joints[p.joint].upper - joints[p.joint].lower)
+                for p in self.parts if p.joint in joints}
+
     def part(self, name: str) -> Part:
         found = next((p for p in self.parts if p.name == name), None)
         if found is None:

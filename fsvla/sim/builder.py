@@ -86,7 +86,7 @@ class BuiltScene:
         return _has_render(self.scene)
 
     def reset(self) -> None:
-        """Bodies back to their spec poses at rest, articulated joints at 0, robots home."""
+        """Bodies back to their spec poses at rest, articulated joints at their start, robots home."""
         for body in self.spec.bodies:
             if body.name in self.bodies:
                 entity = self.bodies[body.name]
@@ -98,7 +98,7 @@ class BuiltScene:
             else:
                 articulation = self.articulations[body.name]
                 articulation.set_root_pose(sapien_pose(body.pose))
-                articulation.set_qpos(np.zeros(articulation.dof, dtype=np.float32))
+                articulation.set_qpos(start_qpos(articulation, body.asset))
                 articulation.set_qvel(np.zeros(articulation.dof, dtype=np.float32))
                 if not body.is_static:
                     articulation.set_root_linear_velocity(np.zeros(3))
@@ -412,8 +412,19 @@ def _build_articulated(scene: Any, body: SceneBody, asset: ArticulatedAsset, tmp
     for joint in articulation.active_joints:
         joint.set_drive_properties(0.0, PASSIVE_JOINT_DAMPING, np.inf, "force")
         joint.set_drive_target(0.0)
-    articulation.set_qpos(np.zeros(articulation.dof, dtype=np.float32))
+    articulation.set_qpos(start_qpos(articulation, asset))
     return articulation
+
+
+def start_qpos(articulation: Any, asset: ArticulatedAsset) -> np.ndarray:
+    """The articulation's joint positions at the start (:meth:`ArticulatedAsset.start_positions`:
+    the asset's joints are already scaled), in its active joints' order."""
+    start = asset.start_positions()
+    qpos = np.zeros(articulation.dof, dtype=np.float32)
+    for index, joint in enumerate(articulation.active_joints):
+        if joint.name in start:
+            qpos[index] = start[joint.name]
+    return qpos
 
 
 def _build_zone(scene: Any, zone: SceneZone, marker: ZoneAsset, renders: bool) -> Any | None:

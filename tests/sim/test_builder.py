@@ -15,6 +15,7 @@ from fsvla.compiler.assets.model import CylinderShape, Material, Pose
 from fsvla.compiler.scene import SceneSpec, lower_scene
 
 from fsvla.sim import BuiltScene, build
+from fsvla.sim.builder import start_qpos
 from fsvla.sim.shapes import collision_shapes, physx_material
 from tests.conftest import require_sapien
 
@@ -82,7 +83,8 @@ def test_rests_stably(spec: SceneSpec) -> None:
         assert np.linalg.norm(component.linear_velocity) < REST_SPEED, name
         assert np.linalg.norm(component.angular_velocity) < REST_SPEED, name
     for name, articulation in built.articulations.items():
-        assert np.all(np.abs(articulation.get_qpos()) < REST_DRIFT), name
+        start = start_qpos(articulation, spec.body(name).asset)
+        assert np.all(np.abs(articulation.get_qpos() - start) < REST_DRIFT), name
     for robot, articulation in built.robot.articulations.items():
         home = built.robot.home_qpos(robot)
         assert np.max(np.abs(articulation.get_qpos() - home)) < HOME_DRIFT, robot
@@ -100,7 +102,8 @@ def test_reset_restores_spec_state(spec: SceneSpec) -> None:
         if body.name in built.bodies:
             assert np.allclose(built.bodies[body.name].pose.p, body.pose.position, atol=1e-6)
         else:
-            assert np.allclose(built.articulations[body.name].get_qpos(), 0.0, atol=1e-6)
+            articulation = built.articulations[body.name]
+            assert np.allclose(articulation.get_qpos(), start_qpos(articulation, body.asset), atol=1e-6)
     for component in _dynamic(built).values():
         assert np.allclose(component.linear_velocity, 0.0)
         assert np.allclose(component.angular_velocity, 0.0)

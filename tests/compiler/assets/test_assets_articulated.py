@@ -181,3 +181,12 @@ def test_generated_urdf_validates_with_yourdfpy_when_installed(kind):
     robot = yourdfpy.URDF.load(io.StringIO(build_asset(kind).urdf), load_meshes=False)
     assert robot.validate()
     assert robot.actuated_joint_names == [f"{EXPECTED[kind][0]}_joint"]
+
+
+@pytest.mark.parametrize("kind", list(EXPECTED))
+def test_a_part_starts_open_by_the_fraction_asked(kind):
+    part, _type, lower, upper = EXPECTED[kind]
+    joint = build_asset(kind).part(part).joint
+    assert build_asset(kind).start_positions() == {joint: pytest.approx(lower)}
+    assert build_asset(kind, {"open": 0.25}).start_positions() == {
+        joint: pytest.approx(lower + 0.25 * (upper - lower))}
