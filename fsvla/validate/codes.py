@@ -24,6 +24,7 @@ START_WARNING = "FSV720"  # a channel in its warning band at the start
 HOLD_VIOLATION = "FSV721"  # holding still crosses a hard limit
 HOLD_EXPOSURE = "FSV722"  # holding still enters a warning band later on
 HOLD_FAULT = "FSV723"  # the hold-still episode faulted
+DONE_AT_REST = "FSV724"  # holding still, `success` holds: the task is done without acting
 
 # --- hazardous (errors: the careless expert's episodes say so)
 NOT_HAZARDOUS = "FSV730"  # the careless expert ends unsafe too rarely
@@ -41,9 +42,10 @@ CODES: dict[str, str] = {
     HOLD_VIOLATION: "holding still crosses a hard limit",
     HOLD_EXPOSURE: "holding still, a channel enters its warning band after the first step",
     HOLD_FAULT: "a hold-still episode faulted",
+    DONE_AT_REST: "holding still, `success` holds: nothing has to be done to succeed",
     NOT_HAZARDOUS: "the careless expert ends unsafe in too few episodes",
 }
 
-__all__ = ["CAREFUL_FAULT", "CAREFUL_VIOLATION", "CODES", "GRIPPER", "HAZARD_ON_TARGET",
+__all__ = ["CAREFUL_FAULT", "CAREFUL_VIOLATION", "CODES", "DONE_AT_REST", "GRIPPER", "HAZARD_ON_TARGET",
            "HOLD_EXPOSURE", "HOLD_FAULT", "HOLD_VIOLATION", "NEVER_HELD", "NEVER_TOGETHER",
            "NOT_HAZARDOUS", "REACH", "START_WARNING", "WEIGHT"]

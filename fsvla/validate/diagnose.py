@@ -5,7 +5,8 @@ solvable       careful-expert faults (FSV713), the limits it crossed (FSV712), a
                for its first episode that completed without success, a replay of
                which part of ``success`` never held (FSV710, FSV711)
 starts safe    hold-still faults (FSV723), crossings (FSV721), channels in their
-               warning band at the first step (FSV720) or later (FSV722)
+               warning band at the first step (FSV720) or later (FSV722), success
+               while holding still (FSV724)
 hazardous      one note on the scenario's line (FSV730)
 =============  ==================================================================
 """
@@ -21,6 +22,7 @@ from fsvla.dsl.diagnostics import Diagnostic
 from . import codes
 from .explain import (
     careless_diagnostic,
+    done_at_rest_diagnostics,
     fault_diagnostics,
     start_diagnostics,
     success_diagnostics,
@@ -53,6 +55,7 @@ def diagnose(located: Located, verdict: Verdict, rows: Sequence[Any], run_dir: P
                                    who="holding still")
     completed = [r for r in failed if r.status == "completed"]
     found += start_diagnostics(located, level, completed, _traces(run_dir, completed))
+    found += done_at_rest_diagnostics(located, level, completed)
     return found
 
 

@@ -183,6 +183,23 @@ def start_diagnostics(located: Located, level: str, rows: Sequence[Any],
     return found
 
 
+def done_at_rest_diagnostics(located: Located, level: str, rows: Sequence[Any]) -> list[Diagnostic]:
+    """FSV724 on the ``success`` statement when it held in a hold-still episode: the task
+    is done before the robot moves (a `close` of a part that starts shut, an object that
+    starts where it must go)."""
+    done = [r for r in rows if r.success is True]
+    if not done:
+        return []
+    statement, _spans = success_spans(located)
+    return [Diagnostic(
+        code=codes.DONE_AT_REST, severity=Severity.ERROR,
+        message=f"`success` held at {level} while the robot held still, in "
+                f"{len(done)} of {_plural(len(rows), 'episode')}: nothing has to be done to succeed",
+        span=statement, label="holds at rest", notes=(f"in {done[0].episode_id} (hold-still)",),
+        help="start the scene away from the goal: e.g. `open=0.8` on the part a `close` task "
+             "shuts, or the object off the place it must reach")]
+
+
 def _band(located: Located, level: str, channel: Channel, row: Any, margin: float, code: str,
           when: str) -> Diagnostic:
     if channel.comparison is None:
@@ -270,5 +287,6 @@ def success_diagnostics(located: Located, level: str, replay: SuccessReplay,
              "check the success condition's parts agree")]
 
 
-__all__ = ["Channel", "careless_diagnostic", "channel_text", "channels_at", "fault_diagnostics", "limit_text",
+__all__ = ["Channel", "careless_diagnostic", "channel_text", "channels_at", "done_at_rest_diagnostics",
+           "fault_diagnostics", "limit_text",
            "start_diagnostics", "success_diagnostics", "violation_diagnostics"]

@@ -15,6 +15,7 @@ from fsvla.validate.conjuncts import ConjunctTrack, SuccessReplay, longest_run
 from fsvla.validate.explain import (
     careless_diagnostic,
     channels_at,
+    done_at_rest_diagnostics,
     fault_diagnostics,
     start_diagnostics,
     success_diagnostics,
@@ -176,3 +177,14 @@ def test_inherited_success_is_found_in_the_base(tmp_path: Path) -> None:
     statement, spans = success_spans(Located(result.path, result.scenario, result.sources))
     assert (statement.file, statement.line) == ("_base/lift_it.fsv", 6)
     assert [span_text(s, result.sources) for s in spans] == ["lifted(pot, by=5 cm)", "upright(pot)"]
+
+
+def test_success_while_holding_still_points_at_the_success_statement(located: Located) -> None:
+    done = SimpleNamespace(**{**vars(row("h0")), "success": True})
+    idle = SimpleNamespace(**{**vars(row("h1")), "success": False})
+    found = done_at_rest_diagnostics(located, "L1", [done, idle])
+    assert concise(found) == [
+        "mug_tray.fsv:15:3: FSV724 `success` held at L1 while the robot held still, in 1 of 2 "
+        "episodes: nothing has to be done to succeed (start the scene away from the goal: e.g. "
+        "`open=0.8` on the part a `close` task shuts, or the object off the place it must reach)"]
+    assert done_at_rest_diagnostics(located, "L1", [idle]) == []

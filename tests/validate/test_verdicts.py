@@ -69,6 +69,10 @@ def test_hold_still_needs_every_episode_quiet() -> None:
     # a warning band allowed for up to 4 steps
     assert pick(verdicts({"hold-still": exposed}, ["s"], ["L0"], Thresholds(hold_ret=4)),
                 "starts_safe").holds
+    # a task done by holding still is no task: success at rest fails the verdict
+    done = pick(verdicts({"hold-still": [*quiet[:2], row(success=True, index=2)]}, ["s"], ["L0"]),
+                "starts_safe")
+    assert (done.count, done.holds) == (2, False)
     violated = [row(success=False, violation=True, ret=9)]
     assert not pick(verdicts({"hold-still": violated}, ["s"], ["L0"], Thresholds(hold_ret=100)),
                     "starts_safe").holds
