@@ -82,11 +82,13 @@ PRECONDITIONS = frozenset({"pick_place", "lift", "stack", "insert", "pour", "bim
 TABLE_HALF = (0.6, 0.4)  # the default table's half size (m)
 GAP = 0.03  # between objects' footprints (m)
 BASE_CLEARANCE = 0.15  # from a robot's mount to an object's footprint (m)
-MAX_ATTEMPTS = 64
+MAX_ATTEMPTS = 64  # draws checked (``fsvla check``, layouts) before giving up
+PLACEMENT_ATTEMPTS = 4096  # draws tried in all, most rejected by placement alone
 
 
 class SamplerError(RuntimeError):
-    """No draw of a seed passed the checks within :data:`MAX_ATTEMPTS` tries."""
+    """No draw of a seed passed the checks within :data:`MAX_ATTEMPTS` checked tries (or
+    :data:`PLACEMENT_ATTEMPTS` tries in all)."""
 
 
 class SampledScenario(BaseModel):
@@ -125,15 +127,20 @@ def sample_scenario(seed: int, *, task: str | None = None, embodiment: str | Non
     if task is not None and embodiment is not None and embodiment not in capable_embodiments(task):
         raise ValueError(f"{embodiment} cannot do {task}: it needs a two-arm embodiment")
     rng = random.Random(seed)
-    for attempt in range(MAX_ATTEMPTS):
+    checked = 0
+    # a placement that does not fit is cheap to redraw (a small arm's reach holds few
+    # layouts of a large container and an object apart): many more of those than checks
+    for attempt in range(PLACEMENT_ATTEMPTS):
         draw = _Draw(rng, seed, task, embodiment)
         try:
             sampled = draw.build(attempt)
         except _Infeasible:
             continue
-        if scenario_problems(sampled.text, deep=deep):
-            continue
-        return sampled
+        checked += 1
+        if not scenario_problems(sampled.text, deep=deep):
+            return sampled
+        if checked >= MAX_ATTEMPTS:
+            break
     raise SamplerError(f"seed {seed}: no draw of {task or 'any task'} on "
                        f"{embodiment or 'any embodiment'} passed the checks in {MAX_ATTEMPTS} tries")
 
@@ -320,7 +327,12 @@ class _Draw:
             travel = ""
             if kind == "drawer_cabinet":
                 travel = f", travel={_cm(min(0.2, size[0] * 0.5))}"
-            call = f"{kind}(size=({_cm(size[0])}, {_cm(size[1])}, {_cm(size[2])}){travel})"
+            # a part a `close` task shuts starts open (a hinged one past upright, where it
+            # stays; short of that it falls shut by itself)
+            start = ""
+            if self.task == "close" and role == "object":
+                start = f", open={u(0.6, 0.9) if kind == 'drawer_cabinet' else 0.9:.2f}"
+            call = f"{kind}(size=({_cm(size[0])}, {_cm(size[1])}, {_cm(size[2])}){travel}{start})"
             # the opening part sweeps toward the robot: keep that ground free
             body = _Body(role, call, kind, math.hypot(size[0], size[1]) / 2 + 0.1 * size[0], size[2])
         else:

@@ -11,6 +11,7 @@ from ..skills import DOWN, UP, Plan, free_speed, nearest_arm, opening_for, trans
 from ..style import Style
 from ..world import World
 from .common import HAND_HALF_WIDTH, HANDLE_DEPTH, required_fraction
+from .lid import LID_PAST_VERTICAL, lift_lid
 
 
 def part_handle(world: World, body: str):
@@ -122,13 +123,60 @@ def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
     return R0
 
 
+#: An open fraction below this is shut: there is nothing to close.
+SHUT = 0.02
+
+
 def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
-    yield from plan_move_part(world, style, roles["object"], max(0.8, required_fraction(
-        world, roles["object"]) + 0.15))
+    """A drawer: pull its handle; a lid: lift it by its knob past upright (where it stays
+    open) or as far as a requirement asks; a hinged door: not yet."""
+    body = roles["object"]
+    part, joint = world.part(body)
+    need = required_fraction(world, body)
+    if _sliding(world, body):
+        yield from plan_move_part(world, style, body, max(0.8, need + 0.15))
+    elif _knob_lid(world, body):
+        span = joint.upper - joint.lower
+        yield from lift_lid(world, style, body, min(max(LID_PAST_VERTICAL, (need + 0.07) * span),
+                                                    0.95 * span))
+    else:
+        raise NotImplementedError(_unsupported(body, part.name, joint.type, "open"))
 
 
 def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
-    yield from plan_move_part(world, style, roles["object"], 0.0)
+    """A drawer: push its front shut; a part already shut is left alone; a lid or a hinged
+    door standing open: not yet."""
+    body = roles["object"]
+    part, joint = world.part(body)
+    if world.open_fraction(body) < SHUT:
+        yield Segment(settle=20, label="already shut")
+    elif _sliding(world, body):
+        yield from push_part_closed(world, style, body)
+    else:  # a lid standing open is pushed over its hinge: not yet
+        raise NotImplementedError(_unsupported(body, part.name, joint.type, "close"))
 
 
-__all__ = ["part_handle", "plan_close", "plan_move_part", "plan_open", "push_part_closed"]
+def _sliding(world: World, body: str) -> bool:
+    """A prismatic part with a `handle` (a drawer)."""
+    part, joint = world.part(body)
+    return joint.type == "prismatic" and _has_shape(world, body, part.link, "handle")
+
+
+def _knob_lid(world: World, body: str) -> bool:
+    """A revolute part with a `knob` and a `panel` (a lid hinged along one edge)."""
+    part, joint = world.part(body)
+    return (joint.type == "revolute" and _has_shape(world, body, part.link, "knob")
+            and _has_shape(world, body, part.link, "panel"))
+
+
+def _has_shape(world: World, body: str, link: str, shape: str) -> bool:
+    return any(lk.name == link and any(s.name == shape for s in lk.collision)
+               for lk in world.asset(body).links)
+
+
+def _unsupported(body: str, part: str, joint: str, verb: str) -> str:
+    return (f"the experts cannot yet {verb} `{body}`'s {joint} `{part}`: they open and "
+            f"close drawers by a `handle` and open lids by a `knob`")
+
+
+__all__ = ["SHUT", "part_handle", "plan_close", "plan_move_part", "plan_open", "push_part_closed"]
