@@ -183,8 +183,8 @@ def test_success_while_holding_still_points_at_the_success_statement(located: Lo
     done = SimpleNamespace(**{**vars(row("h0")), "success": True})
     idle = SimpleNamespace(**{**vars(row("h1")), "success": False})
     found = done_at_rest_diagnostics(located, "L1", [done, idle])
-    assert concise(found) == [
+    assert concise(found) == [(
         "mug_tray.fsv:15:3: FSV724 `success` held at L1 while the robot held still, in 1 of 2 "
         "episodes: nothing has to be done to succeed (start the scene away from the goal: e.g. "
-        "`open=0.8` on the part a `close` task shuts, or the object off the place it must reach)"]
+        "`open=0.8` on the part a `close` task shuts, or the object off the place it must reach)")]
     assert done_at_rest_diagnostics(located, "L1", [idle]) == []
