@@ -5,6 +5,12 @@ file it extends, mesh and URDF assets) is resolved relative to the file that
 names it and must stay inside the allowed roots, which default to the folder of
 the file being checked; a scenario from a stranger cannot make fsvla read
 ``/etc/passwd`` or ``../../secrets``.
+
+Every question a load asks of the file system (what a path resolves to, whether a
+file is there, what a file holds) is recorded with its answer as a :data:`Fact`; the
+result carries them (``LoadResult.inputs``), so that a cache of results
+(:mod:`fsvla.dsl.cache`) can tell whether a load would still give the same result.
+Importing this module is cheap: the parser and the checks load with the first file.
 """
 
 from __future__ import annotations
@@ -13,18 +19,23 @@ import hashlib
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from . import ast
-from .build import build_ast
-from .check import ScenarioChecker
 from .diagnostics import Diagnostic, DiagnosticSink, Severity
-from .merge import merge
-from .models import Scenario
 from .spans import Span
+
+if TYPE_CHECKING:
+    from . import ast
+    from .models import Scenario
 
 MAX_FILE_BYTES = 1_000_000
 MAX_EXTENDS_DEPTH = 16
 BASE_FOLDER = "_base"
+
+#: One thing a load learnt from the file system: (question, path, answer). The questions
+#: are "resolve" (answer: the resolved path), "is_file" ("yes" or "no") and "read" (the
+#: :func:`read_digest` of what reading the file gave).
+Fact = tuple[str, str, str]
 
 
 @dataclass
@@ -36,6 +47,7 @@ class LoadResult:
     diagnostics: list[Diagnostic]
     abstract: bool = False
     sources: dict[str, str] = field(default_factory=dict)  # file -> text, for rendering
+    inputs: tuple[Fact, ...] = ()  # what the load asked of the file system, in order
 
     @property
     def errors(self) -> list[Diagnostic]:
@@ -52,11 +64,28 @@ class ScenarioLoader:
     def __init__(self, allowed_roots: Sequence[Path] = (), display_root: Path | None = None):
         self.allowed_roots = [Path(r).resolve() for r in allowed_roots]
         self.display_root = (display_root or Path.cwd()).resolve()
-        self._parsed: dict[Path, tuple[ast.ScenarioDecl | None, list[Diagnostic], str]] = {}
+        self._parsed: dict[Path, tuple[ast.ScenarioDecl | None, list[Diagnostic], str, str]] = {}
+        self._facts: list[Fact] = []
 
     # ------------------------------------------------------------ public
     def load(self, path: Path | str) -> LoadResult:
-        path = Path(path).resolve()
+        """Check the file at ``path``; the result lists the facts of the file system it used."""
+        self._facts = []
+        result = self._load(Path(path))
+        result.inputs = tuple(self._facts)
+        return result
+
+    def still_holds(self, fact: Fact) -> bool:
+        """Whether the file system answers ``fact``'s question as it did (an unknown
+        question never holds)."""
+        question, where, answer = fact
+        return _ASK.get(question, _unknown)(self, Path(where)) == answer
+
+    def _load(self, given: Path) -> LoadResult:
+        from .check import ScenarioChecker
+        from .merge import merge
+
+        path = self._resolve(given)
         roots = self.allowed_roots or [path.parent]
         display = self.display(path)
         decl, diagnostics, text = self._parse(path)
@@ -79,6 +108,9 @@ class ScenarioLoader:
 
     def loads(self, text: str, name: str = "<string>") -> LoadResult:
         """Check scenario text that has no file; `extends` resolves from the current folder."""
+        from .check import ScenarioChecker
+        from .merge import merge
+
         decl, diagnostics = self._parse_text(text, name)
         if decl is None:
             return LoadResult(name, None, diagnostics, sources={name: text})
@@ -104,21 +136,34 @@ class ScenarioLoader:
 
     # ----------------------------------------------------------- reading
     def _parse(self, path: Path) -> tuple[ast.ScenarioDecl | None, list[Diagnostic], str]:
-        if path in self._parsed:
-            return self._parsed[path]
-        display = self.display(path)
-        text, problem = read_source(path, display)
-        if problem is not None:
-            result = (None, [problem], "")
-        else:
-            decl, diagnostics = self._parse_text(text, display)
-            result = (decl, diagnostics, text)
-        self._parsed[path] = result
-        return result
+        if path not in self._parsed:
+            display = self.display(path)
+            text, problem = read_source(path, display)
+            if problem is not None:
+                self._parsed[path] = (None, [problem], "", read_digest(text, problem))
+            else:
+                decl, diagnostics = self._parse_text(text, display)
+                self._parsed[path] = (decl, diagnostics, text, read_digest(text, None))
+        decl, diagnostics, text, digest = self._parsed[path]
+        self._facts.append(("read", str(path), digest))
+        return decl, diagnostics, text
+
+    def _resolve(self, path: Path) -> Path:
+        """``path`` resolved (symbolic links followed), recorded as a fact."""
+        resolved = path.resolve()
+        self._facts.append(("resolve", str(path), str(resolved)))
+        return resolved
+
+    def _is_file(self, path: Path) -> bool:
+        """Whether ``path`` is a file, recorded as a fact."""
+        found = path.is_file()
+        self._facts.append(("is_file", str(path), _yes_no(found)))
+        return found
 
     @staticmethod
     def _parse_text(text: str, name: str) -> tuple[ast.ScenarioDecl | None, list[Diagnostic]]:
         """The AST, or None and every syntax error (lark's parse recovers to find them all)."""
+        from .build import build_ast
         from .parser import parse_tree  # imports lark: only the commands that read files need it
 
         tree, diagnostics = parse_tree(text, name)
@@ -168,18 +213,18 @@ class ScenarioLoader:
     def _resolve_extends(self, path: Path, extends: ast.Extends, roots: list[Path],
                          sink: DiagnosticSink) -> Path | None:
         if extends.is_path:
-            candidate = (path.parent / extends.target).resolve()
+            candidate = self._resolve(path.parent / extends.target)
             if not _inside(candidate, roots):
                 _outside_roots(sink, extends.span, extends.target, roots)
                 return None
-            if candidate.is_file():
+            if self._is_file(candidate):
                 return candidate
             sink.error("FSV401", f"no file `{extends.target}` to extend", extends.span, "not found",
                        help=f"the path is relative to the scenario's folder (`{self.display(path.parent)}`)")
             return None
         searched = list(_base_candidates(path, extends.target, roots))
         for candidate in searched:
-            if candidate.is_file() and candidate != path:
+            if candidate != path and self._is_file(candidate):
                 return candidate
         sink.error("FSV401", f"no scenario `{extends.target}` to extend", extends.span, "not found",
                    notes=[f"looked for {self.display(c)}" for c in searched[:6]],
@@ -190,11 +235,11 @@ class ScenarioLoader:
     # ------------------------------------------------------------- assets
     def _path_resolver(self, path: Path, roots: list[Path], sink: DiagnosticSink):
         def resolve(value: ast.String) -> str | None:
-            candidate = (path.parent / value.value).resolve()
+            candidate = self._resolve(path.parent / value.value)
             if not _inside(candidate, roots):
                 _outside_roots(sink, value.span, value.value, roots)
                 return None
-            if not candidate.is_file():
+            if not self._is_file(candidate):
                 sink.error("FSV404", f"asset file `{value.value}` not found", value.span, "no such file",
                            help=f"paths are relative to the scenario's folder (`{self.display(path.parent)}`)")
                 return None
@@ -206,6 +251,38 @@ def source_digest(text: str) -> str:
     """SHA-256 of a scenario's text. A string given to ``loads`` may hold lone surrogates
     (a file never does: it is decoded strictly), which plain UTF-8 cannot encode."""
     return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
+
+
+def read_digest(text: str, problem: Diagnostic | None) -> str:
+    """What reading a file gave, as one string: the SHA-256 of its text, or of the
+    diagnostic that says why it has none."""
+    if problem is None:
+        return source_digest(text)
+    return "unreadable:" + hashlib.sha256(problem.model_dump_json().encode("utf-8")).hexdigest()
+
+
+def _ask_resolve(loader: ScenarioLoader, path: Path) -> str:
+    return str(path.resolve())
+
+
+def _ask_is_file(loader: ScenarioLoader, path: Path) -> str:
+    return _yes_no(path.is_file())
+
+
+def _ask_read(loader: ScenarioLoader, path: Path) -> str:
+    return read_digest(*read_source(path, loader.display(path)))
+
+
+def _unknown(loader: ScenarioLoader, path: Path) -> None:
+    return None
+
+
+def _yes_no(found: bool) -> str:
+    return "yes" if found else "no"
+
+
+#: How each question of a :data:`Fact` is asked again.
+_ASK = {"resolve": _ask_resolve, "is_file": _ask_is_file, "read": _ask_read}
 
 
 def _with_overflow_note(sink: DiagnosticSink) -> list[Diagnostic]:

@@ -87,6 +87,22 @@ def _load_all(paths: Sequence[str | Path], roots: Sequence[Path]):
     return [loader.load(file) for file in files]
 
 
+def _check_all(paths: Sequence[str | Path], roots: Sequence[Path], use_cache: bool):
+    """What `fsvla check` prints of each file: from the result cache where the file and
+    everything it reads are unchanged (:mod:`fsvla.dsl.cache`), else checked afresh."""
+    if not use_cache:
+        return _load_all(paths, roots)
+    from .dsl.cache import CheckCache, cache_folder
+    from .dsl.loader import ScenarioLoader
+
+    folder = cache_folder()
+    if folder is None:
+        return _load_all(paths, roots)
+    files = collect_files(paths)
+    cache = CheckCache(ScenarioLoader(allowed_roots=list(roots) or default_roots(paths)), folder)
+    return [cache.load(file) for file in files]
+
+
 def _report(results, output_format: str, quiet: bool = False) -> tuple[int, int]:
     from .dsl.render import render_concise, render_full, render_json, summary_line
 
@@ -119,15 +135,19 @@ def _report(results, output_format: str, quiet: bool = False) -> tuple[int, int]
 @click.option("--deep", is_flag=True, help="Also run the static checks of `fsvla validate --static` "
               "(reach, gripper opening, force limits against weights, hazards on targets); "
               "loads the robots, so slower.")
+@click.option("--no-cache", is_flag=True, help="Check every file afresh, neither reading nor writing "
+              "the cache of results (as does FSVLA_NO_CACHE=1).")
 def check(paths: tuple[str, ...], roots: tuple[Path, ...], output_format: str, strict: bool,
-          deep: bool) -> None:
+          deep: bool, no_cache: bool) -> None:
     """Check scenarios and report every problem found: .fsv files, folders, built-in
     names, or selectors (subset:NAME, suite:NAME, embodiment:NAME)."""
-    results = _load_all(paths, roots)
     if deep:
         from .validate.static import deepen
 
+        results = _load_all(paths, roots)
         deepen(results, list(roots) or default_roots(paths))
+    else:
+        results = _check_all(paths, roots, use_cache=not no_cache)
     errors, warnings = _report(results, output_format)
     sys.exit(1 if errors or (strict and warnings) else 0)
 
