@@ -75,7 +75,7 @@ def _size3(default: tuple[float, float, float], lo: float = 0.005, hi: float = 2
 
 
 #: How far an articulated body's part starts open: a fraction of its joint's range.
-_OPEN = Param(name="open", default=0.0, minimum=0.0, maximum=1.0,
+_OPEN = Param(name="open", minimum=0.0, maximum=1.0,
               doc="how far the part starts open, as a fraction of its range (0: shut, 1: fully open)")
 _MASS = Param(name="mass", dimension=Dimension.MASS, minimum=0.001, maximum=50.0,
               doc="overrides the mass computed from the asset's density")
