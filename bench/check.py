@@ -10,6 +10,9 @@ reach ``--files``; nothing is written under scenarios/. Each figure is the media
 - warm: the cache filled by an earlier run (every file's inputs hashed and compared);
 - no cache: ``--no-cache``, for reference.
 
+Beside each wall time, the CPU time (user + system) the process used: on a busy machine
+wall times grow with the load, CPU times much less.
+
 Lark's parser cache is warm throughout (a first run fills it). Bytecode caching is as
 the environment sets it; where PYTHONDONTWRITEBYTECODE is set, the three are timed again
 with .pyc files in a temporary PYTHONPYCACHEPREFIX. Each run's output must equal the
@@ -22,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import statistics
 import subprocess
@@ -49,38 +53,47 @@ def scenario_tree(folder: Path, files: int) -> Path:
     return tree
 
 
-def check_once(tree: Path, env: dict[str, str], *extra: str) -> tuple[float, str]:
-    """Seconds one `fsvla check` of ``tree`` takes as a process, and what it prints."""
+def check_once(tree: Path, env: dict[str, str], *extra: str) -> tuple[float, float, str]:
+    """Wall and CPU seconds one `fsvla check` of ``tree`` takes as a process, and what it prints."""
     args = [sys.executable, "-m", "fsvla", "check", "--format", "concise", *extra, str(tree)]
+    cpu = _children_cpu()
     start = time.perf_counter()
     done = subprocess.run(args, check=False, capture_output=True, text=True, env=env, cwd=tree.parent)
     seconds = time.perf_counter() - start
     if done.returncode != 0:
         raise SystemExit(f"{' '.join(args)} failed ({done.returncode}):\n{done.stdout}{done.stderr}")
-    return seconds, done.stdout
+    return seconds, _children_cpu() - cpu, done.stdout
 
 
-def time_checks(tree: Path, env: dict[str, str], repeat: int, folder: Path) -> dict[str, float]:
-    """Median seconds of `fsvla check` with a cold cache, a warm cache and no cache."""
-    _, expected = check_once(tree, env, "--no-cache")  # fills lark's cache (and any .pyc)
-    samples: dict[str, list[float]] = {"cold": [], "warm": [], "no cache": []}
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def time_checks(tree: Path, env: dict[str, str], repeat: int,
+                folder: Path) -> dict[str, tuple[float, float]]:
+    """Median wall and CPU seconds of `fsvla check` with a cold cache, a warm cache and none."""
+    *_, expected = check_once(tree, env, "--no-cache")  # fills lark's cache (and any .pyc)
+    samples: dict[str, list[tuple[float, float]]] = {"cold": [], "warm": [], "no cache": []}
     warm_env = {**env, "FSVLA_CACHE_DIR": str(folder / "warm")}
     check_once(tree, warm_env)
     for run in range(repeat):
         cold_env = {**env, "FSVLA_CACHE_DIR": str(folder / f"cold{run}")}
         for name, (run_env, extra) in {"cold": (cold_env, ()), "warm": (warm_env, ()),
                                        "no cache": (env, ("--no-cache",))}.items():
-            seconds, out = check_once(tree, run_env, *extra)
+            seconds, cpu, out = check_once(tree, run_env, *extra)
             if out != expected:
                 raise SystemExit(f"`fsvla check` printed something else with the {name} cache")
-            samples[name].append(seconds)
-    return {name: statistics.median(values) for name, values in samples.items()}
+            samples[name].append((seconds, cpu))
+    return {name: (statistics.median(s for s, _ in values), statistics.median(c for _, c in values))
+            for name, values in samples.items()}
 
 
-def report(label: str, figures: dict[str, float], repeat: int) -> None:
-    print(f"{label} (median of {repeat}):")
-    for name, seconds in figures.items():
-        print(f"  {name:9} {seconds:6.3f} s   target < {TARGET_PROCESS_S} s  ratio {seconds / TARGET_PROCESS_S:.2f}")
+def report(label: str, figures: dict[str, tuple[float, float]], repeat: int) -> None:
+    print(f"{label} (median of {repeat}; load average {os.getloadavg()[0]:.2f}):")
+    for name, (seconds, cpu) in figures.items():
+        print(f"  {name:9} {seconds:6.3f} s (CPU {cpu:5.3f} s)   target < {TARGET_PROCESS_S} s  "
+              f"ratio {seconds / TARGET_PROCESS_S:.2f}")
 
 
 def main() -> None:
