@@ -88,3 +88,13 @@ def short_scenario(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp("scenarios") / "short_lift.fsv"
     path.write_text(SHORT_SCENARIO, encoding="utf-8")
     return path
+
+
+@pytest.fixture(autouse=True)
+def check_cache_dir(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """`fsvla check`'s result cache in a fresh temporary folder for each test, never the
+    user's (subprocesses inherit it through the environment)."""
+    folder = tmp_path_factory.mktemp("fsvla-cache")
+    monkeypatch.setenv("FSVLA_CACHE_DIR", str(folder))
+    monkeypatch.delenv("FSVLA_NO_CACHE", raising=False)
+    return folder
