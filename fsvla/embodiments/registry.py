@@ -42,13 +42,14 @@ def load_embodiment(name_or_path: str | Path) -> EmbodimentSpec:
     text = str(name_or_path)
     if text in builtin_embodiments():
         data = tomllib.loads((_builtin_folder() / f"{text}.toml").read_text())
-        return EmbodimentSpec.model_validate(data)
+        return EmbodimentSpec.model_validate(_anchor_pieces(data, Path(str(_builtin_folder()))))
     path = Path(text).expanduser()
     if path.suffix == ".toml" or path.is_file():
         if not path.is_file():
             raise FileNotFoundError(f"embodiment file not found: {path}")
         data = tomllib.loads(path.read_text())
-        return EmbodimentSpec.model_validate(_anchor_paths(data, path.parent.resolve()))
+        base = path.parent.resolve()
+        return EmbodimentSpec.model_validate(_anchor_pieces(_anchor_paths(data, base), base))
     raise UnknownEmbodimentError(_unknown_message(text))
 
 
@@ -79,6 +80,22 @@ def _anchor_paths(data: dict[str, Any], base: Path) -> dict[str, Any]:
                     local = base / value
                     if local.is_file():
                         robot[key] = str(local)
+        anchored.append(robot)
+    return {**data, "robots": anchored}
+
+
+def _anchor_pieces(data: dict[str, Any], base: Path) -> dict[str, Any]:
+    """Each robot's ``collision_pieces`` folders made absolute, relative to ``base`` (the
+    embodiment file's folder)."""
+    robots = data.get("robots")
+    if not isinstance(robots, list):
+        return data
+    anchored = []
+    for robot in robots:
+        if isinstance(robot, dict) and isinstance(robot.get("collision_pieces"), dict):
+            robot = {**robot, "collision_pieces": {
+                name: str(folder if Path(folder).is_absolute() else base / folder)
+                for name, folder in robot["collision_pieces"].items()}}
         anchored.append(robot)
     return {**data, "robots": anchored}
 

@@ -123,6 +123,12 @@ class RobotSpec(_Strict):
         description="positions for the robot's other joints (head, torso); unlisted ones hold 0",
     )
     hold_drive: DriveSpec = DriveSpec(stiffness=1e4, damping=1e3, force_limit=1000.0)
+    collision_pieces: dict[str, str] = Field(
+        default_factory=dict,
+        description="collision mesh file name (as the URDF names it, without folders) -> a "
+        "folder of its convex pieces (*.obj), relative to the embodiment's file: the loader "
+        "takes one convex hull per collision mesh, which fills a gripper's jaws in",
+    )
     self_collisions: bool = Field(
         True,
         description="simulate contacts between this robot's own links (but the pairs its "

@@ -180,7 +180,8 @@ def _has_render_system(scene: Any) -> bool:
 
 
 def _load_articulation(scene: Any, robot: RobotSpec, tmp: Path, keep_visuals: bool) -> Any:
-    urdf = prepare_urdf(resolve_asset(robot.urdf), tmp, keep_visuals)
+    pieces = {name: Path(folder) for name, folder in robot.collision_pieces.items()}
+    urdf = prepare_urdf(resolve_asset(robot.urdf), tmp, keep_visuals, pieces)
     srdf = str(resolve_asset(robot.srdf)) if robot.srdf else None
     loader = scene.create_urdf_loader()
     loader.fix_root_link = True

@@ -1,10 +1,15 @@
-"""Prepare a URDF for SAPIEN's loader: absolute mesh paths and, for a physics-only
-scene, no visual elements (SAPIEN builds render bodies for visuals and fails without
-a render device). The installed file is never modified; a copy is written instead."""
+"""Prepare a URDF for SAPIEN's loader: absolute mesh paths; for a physics-only scene, no
+visual elements (SAPIEN builds render bodies for visuals and fails without a render
+device); and collision meshes swapped for their convex pieces where the embodiment ships
+them (the loader takes one convex hull of each collision mesh: a gripper's fixed jaw
+printed in one piece with its wrist becomes a wedge). The installed file is never
+modified; a copy is written instead."""
 
 from __future__ import annotations
 
+import copy
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping
 from pathlib import Path
 
 from fsvla.embodiments.assets import package_share_root
@@ -34,14 +39,22 @@ def resolve_uri(uri: str, urdf_dir: Path) -> str:
     return str(path if path.is_absolute() else (urdf_dir / path).resolve())
 
 
-def prepare_urdf(urdf: Path, out_dir: Path, keep_visuals: bool) -> Path:
-    """Write a loader-ready copy of ``urdf`` into ``out_dir`` and return its path."""
+def prepare_urdf(urdf: Path, out_dir: Path, keep_visuals: bool,
+                 pieces: Mapping[str, Path] | None = None) -> Path:
+    """Write a loader-ready copy of ``urdf`` into ``out_dir`` and return its path.
+
+    ``pieces`` maps a collision mesh's file name (without folders, as the URDF names it)
+    to a folder of convex pieces (``*.obj``): each collision element of that mesh becomes
+    one element per piece, at the same origin and scale."""
     root = ET.parse(urdf).getroot()
     urdf_dir = urdf.resolve().parent
     if not keep_visuals:
         for link in root.iter("link"):
             for visual in link.findall("visual"):
                 link.remove(visual)
+    if pieces:
+        for link in root.iter("link"):
+            _swap_for_pieces(link, pieces)
     for element in root.iter():
         if element.tag in ("mesh", "texture") and element.get("filename"):
             element.set("filename", resolve_uri(element.get("filename", ""), urdf_dir))
@@ -52,4 +65,30 @@ def prepare_urdf(urdf: Path, out_dir: Path, keep_visuals: bool) -> Path:
     return out
 
 
-__all__ = ["prepare_urdf", "resolve_uri"]
+def convex_piece_files(folder: Path) -> list[Path]:
+    """The convex pieces in ``folder`` (``*.obj``, in name order); an error when none."""
+    found = sorted(folder.glob("*.obj"))
+    if not found:
+        raise FileNotFoundError(f"no convex pieces (*.obj) in {folder}")
+    return found
+
+
+def _swap_for_pieces(link: ET.Element, pieces: Mapping[str, Path]) -> None:
+    for collision in link.findall("collision"):
+        mesh = collision.find("geometry/mesh")
+        if mesh is None:
+            continue
+        name = mesh.get("filename", "").replace("\\", "/").rsplit("/", 1)[-1]
+        if name not in pieces:
+            continue
+        at = list(link).index(collision)
+        link.remove(collision)
+        for offset, piece in enumerate(convex_piece_files(pieces[name])):
+            clone = copy.deepcopy(collision)
+            part = clone.find("geometry/mesh")
+            assert part is not None
+            part.set("filename", str(piece.resolve()))
+            link.insert(at + offset, clone)
+
+
+__all__ = ["convex_piece_files", "prepare_urdf", "resolve_uri"]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterator
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -164,3 +165,16 @@ def test_the_panda_srdf_pairs_fit_the_bits() -> None:
     assert max(bits.values()) < 1 << 31
     assert bits["panda_hand"] & bits["panda_link7"]
     assert not bits["panda_link1"] & bits["panda_hand"] or ("panda_hand", "panda_link1") in disabled
+
+
+def test_a_jaw_in_convex_pieces_has_one_shape_per_piece() -> None:
+    # the SO-101's fixed jaw and wrist are one mesh; as one hull they fill the jaws' gap
+    from fsvla.sim.urdf import convex_piece_files
+
+    spec = load_embodiment("so101")
+    folder = Path(spec.robots[0].collision_pieces["wrist_roll_follower_so101_v1.stl"])
+    scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
+    robot = load_robot(scene, spec)
+    link = next(lk for lk in robot.articulations["so101"].get_links() if lk.name == "gripper_link")
+    # the link's other mesh (its servo) stays one hull
+    assert len(link.collision_shapes) == len(convex_piece_files(folder)) + 1

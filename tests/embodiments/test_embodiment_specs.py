@@ -174,3 +174,21 @@ def test_importing_fsvla_does_not_import_sapien() -> None:
         "assert 'sapien' not in sys.modules, 'sapien imported'"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.parametrize("name", builtin_embodiments())
+def test_builtin_collision_pieces_are_shipped(name: str) -> None:
+    from fsvla.sim.urdf import convex_piece_files
+
+    for robot in load_embodiment(name).robots:
+        for mesh, folder in robot.collision_pieces.items():
+            assert Path(folder).is_absolute(), (mesh, folder)
+            assert len(convex_piece_files(Path(folder))) >= 2, mesh
+
+
+def test_user_toml_collision_pieces_are_anchored_to_its_folder(tmp_path: Path) -> None:
+    path = tmp_path / "mine.toml"
+    path.write_text(USER_TOML.replace(
+        'urdf = "robot.urdf"', 'urdf = "robot.urdf"\ncollision_pieces = { "jaw.stl" = "pieces/jaw" }'))
+    (tmp_path / "robot.urdf").write_text("<robot name='r'/>")
+    assert load_embodiment(path).robots[0].collision_pieces == {"jaw.stl": str(tmp_path / "pieces/jaw")}
