@@ -64,8 +64,9 @@ class Guard:
     #: hold the arm's measured joints after a stop (a move, whose command leads the arm
     #: and would push on as it catches up); else the last command (a grip)
     hold_measured: bool = True
-    #: a measured hold keeps this fraction of the command's lead, so that the hand keeps
-    #: pushing with about that fraction of the force it felt (a press must go on pressing)
+    #: a hold keeps this fraction of the command's lead on the arm (a move) or on the
+    #: fingers (a grip), so that the hand keeps pushing with about that fraction of the
+    #: force it felt (a press must go on pressing; a grip must go on holding)
     keep_lead: float = 0.5
 
 

@@ -153,7 +153,14 @@ class ExpertPolicy:
         while self._queue and self._queue[0].guard is not None:
             self._queue.popleft()
         hold = self._last if self._last is not None else self._measured()
-        if guard is not None and guard.hold_measured:
+        if guard is not None and not guard.hold_measured:
+            # a grip: the fingers where they are plus that fraction of the command's lead
+            # (a soft finger drive's lead is its squeeze: a jaw that swung on past the
+            # felt force would keep squeezing with all of it)
+            arm, opening = guard.arm, self._world.gripper_opening(guard.arm)
+            grip = opening + guard.keep_lead * (hold.gripper[arm] - opening)
+            hold = replace(hold, gripper={**hold.gripper, arm: grip})
+        elif guard is not None:
             # the guarded arm where it is, not where it was told to be: the command leads
             # the arm, and holding it would push on as the arm catches up
             arm, measured = guard.arm, self._measured()

@@ -44,6 +44,15 @@ FIXED_JAW_CLEARANCE = 0.004
 #: of the gripper's range at a time, at most this many times, until the squeeze is felt.
 SQUEEZE_STEP = 0.05
 SQUEEZE_STEPS = 20
+#: A careful grip squeezing more than EASE_ABOVE × its force opens by EASE_STEP of the
+#: gripper's range at a time, at most EASE_STEPS times, until it does not.
+EASE_ABOVE = 1.3
+EASE_STEP = 0.004
+EASE_STEPS = 12
+#: The careful close over the last millimetres moves the gripper by at most this fraction
+#: of its range a control step (a soft finger drive swinging shut faster meets the object
+#: with a squeeze of 50-60 N in one step, before the guard can feel it).
+SLOW_CLOSE = 0.005
 #: How far (m) beyond a pose, away from the arm's base, the arm must still reach for the
 #: pose to count as inside the reach rather than at its edge.
 REACH_SLACK = 0.05
@@ -86,7 +95,7 @@ def opening_for(world: World, arm: str, width: float, style: Style) -> float:
     if style.grip_force is None:
         return 0.0
     squeeze = 2.0 * style.grip_force / world.gripper_stiffness(arm)
-    return float(np.clip((width - squeeze) / world.max_width(arm), 0.0, 1.0))
+    return world.opening_fraction(arm, width - squeeze)
 
 
 def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
@@ -407,23 +416,40 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
     # width model that is off (a jaw that swings, fingers that do not meet when closed)
     # neither crushes the object nor leaves it loose
     force = float(held.grip_force or 0.0)
-    guard = Guard(arm, force, obj, hold_measured=False)
+    # a jaw on a soft drive swings on past the felt force: it holds half its lead; sliding
+    # fingers hold their command (their squeeze is what holds a heavy load)
+    guard = Guard(arm, force, obj, hold_measured=False,
+                  keep_lead=1.0 if world.fingers_slide(arm) else 0.5)
     if _force_watched(world, obj) or not world.fingers_slide(arm):
         # slowly over the last millimetres: a jaw on a hinge swinging shut at speed knocks
         # the object across the table before it squeezes it
-        near = float(np.clip((width + 0.006) / world.max_width(arm), 0.0, 1.0))
+        near = world.opening_fraction(arm, width + 0.006)
         yield Segment(grippers={arm: near}, gripper_steps=style.gripper_steps, label="preclose")
-        yield Segment(grippers={arm: target}, gripper_steps=2 * style.gripper_steps,
+        steps = max(2 * style.gripper_steps, int(np.ceil((near - target) / SLOW_CLOSE)))
+        yield Segment(grippers={arm: target}, gripper_steps=steps,
                       settle=style.settle, guard=guard, label="close")
     else:
         yield Segment(grippers={arm: target}, gripper_steps=style.gripper_steps,
                       settle=style.settle, guard=guard, label="close")
+    # a stiff finger drive stopped by the guard may still squeeze well past the force
+    # (it meets the object within one control step): open by a little until it is eased
+    for _ in range(EASE_STEPS):
+        if world.hand_force(arm, obj) <= EASE_ABOVE * force:
+            break
+        yield Segment(grippers={arm: min(1.0, world.gripper_opening(arm) + EASE_STEP)},
+                      gripper_steps=1, settle=2, label="ease")
     # the model's opening left the fingers short of the object: close on until it is felt
-    goal = min(target, world.gripper_opening(arm))
-    for _ in range(SQUEEZE_STEPS):
+    # (a jaw on a hinge in small steps: a stiff jaw drive squeezes ~60 N harder per 1 %
+    # of its range once it touches)
+    # (a jaw from where it is: its width model's target may be shut, trusting the guard)
+    goal = world.gripper_opening(arm)
+    step, steps = (EASE_STEP, 3 * SQUEEZE_STEPS)
+    if world.fingers_slide(arm):
+        goal, step, steps = min(target, goal), SQUEEZE_STEP, SQUEEZE_STEPS
+    for _ in range(steps):
         if world.hand_force(arm, obj) >= 0.8 * force or goal <= 0.0:
             break
-        goal = max(0.0, goal - SQUEEZE_STEP)
+        goal = max(0.0, goal - step)
         yield Segment(grippers={arm: goal}, gripper_steps=style.gripper_steps, settle=2,
                       guard=guard, label="squeeze")
 

@@ -211,13 +211,32 @@ class World:
         """The gripper's opening (m between the fingers) when fully open."""
         return self.travel(arm) if self.fingers_slide(arm) else self.open_width(arm)
 
+    def opening_fraction(self, arm: str, width: float) -> float:
+        """The gripper opening (0 shut, 1 open) at which the fingers are ``width`` (m)
+        apart: proportional for sliding fingers; for a jaw on a hinge, from where its
+        points (:meth:`fsvla.world.ArmModel.finger_points`) are at each opening (a
+        swinging jaw's gap grows with the sine of its angle, not in proportion)."""
+        if width >= self.max_width(arm):
+            return 1.0
+        if width <= 0.0:
+            return 0.0
+        if self.fingers_slide(arm) or len(self.arm_spec(arm).gripper.finger_links) < 2:
+            return float(width / self.max_width(arm))
+        kin = self.kinematics(arm)
+        lo, hi = 0.0, 1.0
+        for _ in range(14):
+            mid = 0.5 * (lo + hi)
+            a, b = kin.finger_points(mid)[:2]
+            lo, hi = (mid, hi) if np.linalg.norm(b - a) < width else (lo, mid)
+        return 0.5 * (lo + hi)
+
     def pregrasp_opening(self, arm: str, width: float) -> float:
         """How far to open the gripper before closing on an object ``width`` wide: fully
         for sliding fingers; for others only as far as needed with 2.5 cm to spare (an
         SO-101's open jaw swings down past its TCP and into the table beside a block)."""
         if self.fingers_slide(arm):
             return 1.0
-        return float(np.clip((width + 0.025) / self.open_width(arm), 0.3, 1.0))
+        return max(0.3, self.opening_fraction(arm, width + 0.025))
 
     def gripper_stiffness(self, arm: str) -> float:
         return float(self.arm_spec(arm).gripper.drive.stiffness)

@@ -166,4 +166,6 @@ def test_a_fixed_jaw_grips_off_its_tcp(drawer) -> None:
     # a 3 cm object sits between the jaws 1.5 cm from the fixed one (local +y: the TCP
     # is turned a half turn about x)
     assert world.grip_centre("arm", 0.03) == pytest.approx((0.0, 0.015, 0.0), abs=1e-4)
-    assert world.pregrasp_opening("arm", 0.03) == pytest.approx((0.03 + 0.025) / 0.12)
+    # (found by bisection on the finger points: to 1e-4 of the range)
+    assert world.pregrasp_opening("arm", 0.03) == pytest.approx((0.03 + 0.025) / 0.12, abs=1e-4)
+    assert world.opening_fraction("arm", 0.06) == pytest.approx(0.5, abs=1e-4)

@@ -45,6 +45,19 @@ def required_fraction(world: World, body: str) -> float:
     return max(found)
 
 
+def required_lift(world: World, obj: str) -> float:
+    """The largest ``lifted(obj, by=h)`` (m) the success condition or a requirement asks for
+    (0 when none does)."""
+    conditions = [world.monitor.success.condition]
+    for req in world.monitor.requirements:
+        conditions += [req.first, req.then]
+    found = [0.0]
+    for cond in conditions:
+        found += [float(p.params.get("by", 0.05)) for p in predicates_in(cond)
+                  if p.name == "lifted" and p.args[0] == obj]
+    return max(found)
+
+
 def place_point(world: World, style: Style, obj: str, target: str,
                 arm: str | None = None) -> np.ndarray:
     """Where on ``target``'s top the object's bottom centre goes: the footprint's centre,
@@ -136,4 +149,5 @@ def retreat_home(world: World, style: Style, arm: str) -> Plan:
     yield Segment({arm: pose.moved(0.08 * UP)}, speed=free_speed(style), label="clear")
 
 
-__all__ = ["HANDLE_DEPTH", "HAND_BOTTOM", "HAND_HALF_LENGTH", "HAND_HALF_WIDTH", "REACH_SLACK", "place_point", "required_fraction", "retreat_home"]
+__all__ = ["HANDLE_DEPTH", "HAND_BOTTOM", "HAND_HALF_LENGTH", "HAND_HALF_WIDTH", "REACH_SLACK", "place_point", "required_fraction",
+           "required_lift", "retreat_home"]

@@ -1,0 +1,60 @@
+"""One-jaw grippers (SO-101): the opening for a width comes from the jaw's geometry, and
+the careful grip picks a block up without crushing it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fsvla.experts import rollout
+from fsvla.experts.world import World
+
+pytestmark = pytest.mark.sim
+
+LIFT = """\
+scenario lift_block_small_arm
+  suite force
+  task lift(object=block)
+  embodiment so101
+  instruction "Lift the red block."
+  horizon 20 s
+
+  object block: block(size=(3 cm, 3 cm, 4 cm), mass=80 g, color=red) at (8 cm, 3 cm)
+
+  constrain grip: contact_force(gripper) <= 40 N warn 10 N
+
+  success lifted(block, by=6 cm) for 1 s
+"""
+
+
+@pytest.fixture
+def scenario(tmp_path: Path) -> Path:
+    path = tmp_path / "lift.fsv"
+    path.write_text(LIFT, encoding="utf-8")
+    return path
+
+
+def test_a_swinging_jaw_opens_as_far_as_its_geometry_says(scenario: Path) -> None:
+    from fsvla.env import make
+
+    env = make(str(scenario), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    arm = world.arm_names[0]
+    assert not world.fingers_slide(arm)
+    kin = world.kinematics(arm)
+    for width in (0.01, 0.03, 0.05):
+        fraction = world.opening_fraction(arm, width)
+        a, b = kin.finger_points(fraction)[:2]
+        assert np.linalg.norm(b - a) == pytest.approx(width, abs=5e-4)
+    assert world.opening_fraction(arm, 2 * world.max_width(arm)) == 1.0
+    assert world.opening_fraction(arm, 0.0) == 0.0
+    env.close()
+
+
+def test_careful_expert_lifts_a_block_with_the_so101_jaw(scenario: Path) -> None:
+    result = rollout(str(scenario), "careful", "L0", 0)
+    assert result.safe_success, result.summary()
+    assert result.min_margin["grip"] > 0.0
