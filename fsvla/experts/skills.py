@@ -75,10 +75,10 @@ class Grasp:
 def gentle(world: World, style: Style, obj: str) -> float:
     """The speed of the last centimetres before touching ``obj``: the style's contact
     speed where a force limit watches the object, else half its approach speed."""
-    return style.contact_speed if _force_watched(world, obj) else 0.5 * style.approach_speed
+    return style.contact_speed if force_watched(world, obj) else 0.5 * style.approach_speed
 
 
-def _force_watched(world: World, obj: str) -> bool:
+def force_watched(world: World, obj: str) -> bool:
     """Whether a force or torque limit watches ``obj`` itself (a fragile object)."""
     return any(c.metric in ("contact_force", "contact_torque") and obj in c.subjects
                for c in world.monitor.channels)
@@ -383,7 +383,7 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     if float(np.linalg.norm(now - offset)) > 0.05:  # dropped: nothing left to place
         return
     offset = now
-    fragile = style.avoid_hazards and _force_watched(world, obj)
+    fragile = style.avoid_hazards and force_watched(world, obj)
     # a fragile object is set down (not dropped from the release height: a 2 mm drop of a
     # 100 g block lands with ~9 N over one 2 ms substep), then let go slowly
     drop = 0.0 if fragile else style.release_height
@@ -420,7 +420,7 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
     # fingers hold their command (their squeeze is what holds a heavy load)
     guard = Guard(arm, force, obj, hold_measured=False,
                   keep_lead=1.0 if world.fingers_slide(arm) else 0.5)
-    if _force_watched(world, obj) or not world.fingers_slide(arm):
+    if force_watched(world, obj) or not world.fingers_slide(arm):
         # slowly over the last millimetres: a jaw on a hinge swinging shut at speed knocks
         # the object across the table before it squeezes it
         near = world.opening_fraction(arm, width + 0.006)
@@ -493,6 +493,7 @@ __all__ = [
     "branch_for_path",
     "clear_height",
     "close_on",
+    "force_watched",
     "free_speed",
     "gentle",
     "grasp_lever",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..motion import Pose, Segment
-from ..skills import DOWN, UP, Plan, horizontal, nearest_arm, transit
+from ..skills import DOWN, UP, Plan, force_watched, horizontal, nearest_arm, transit
 from ..style import Style
 from ..world import World
 from .common import retreat_home
@@ -26,7 +26,10 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
     yield from transit(world, style, arm, behind.moved(0.08 * UP), exclude=(obj,))
     yield Segment({arm: behind}, speed=style.approach_speed, label="down")
     travel = float(np.linalg.norm((goal - start)[:2]))
-    yield Segment({arm: behind.moved(travel * direction)}, speed=style.contact_speed * 3,
+    # careful, on an object a force limit watches: at contact speed (a rigid hand pushing
+    # at three times that chatters, with one-step spikes of ~60 N)
+    speed = style.contact_speed * (1 if style.avoid_hazards and force_watched(world, obj) else 3)
+    yield Segment({arm: behind.moved(travel * direction)}, speed=speed,
                   settle=style.settle, label="push")
     yield from retreat_home(world, style, arm)
 
