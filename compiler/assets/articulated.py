@@ -23,7 +23,7 @@ from pathlib import Path
 
 import jinja2
 
-from .geometry import bounds_of, inertia_tensor
+from .geometry import bounds_of, inertia_tensor, union_aabb
 from .materials import PLASTIC, WOOD, Substance, physics_material
 from .model import ArticulatedAsset, BoxShape, ParamValue, Part, Pose, Rgba
 from .urdf import parse_urdf
@@ -117,7 +117,16 @@ def _assemble(
     named = [
         Part(name=part, link=joints[joint].child, joint=joint) for part, joint in parts.items()
     ]
-    bounds, footprint = bounds_of(*structure.rest_aabb())
+    # a part that starts open (``open``) stands out of the body: the bounds hold it there too,
+    # so that layouts keep clutter and other objects out of an open drawer's way
+    shut = structure.rest_aabb()
+    lo, hi = shut
+    fraction = float(params.get("open", 0.0) or 0.0)
+    if fraction > 0.0:
+        start = {j.name: j.lower + fraction * (j.upper - j.lower)
+                 for j in structure.joints if j.name in parts.values()}
+        lo, hi = union_aabb([shut, structure.rest_aabb(start)])
+    bounds, footprint = bounds_of(lo, hi)
     total_mass = sum(link.mass for link in structure.links)
     volume = sum(
         8.0 * math.prod(s.half_size)

@@ -10,14 +10,14 @@ simulator's URDF loader does by default.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
-from ..pose import pose_matrix, rpy_quat
+from ..pose import axis_angle_matrix, pose_matrix, rpy_quat
 from .geometry import inline_mesh, shape_aabb, union_aabb
 from .model import (
     BoxShape,
@@ -46,9 +46,10 @@ class UrdfStructure:
     links: list[Link]
     joints: list[Joint]
 
-    def rest_aabb(self) -> tuple[np.ndarray, np.ndarray]:
-        """Bounds of every collision shape with all joints at zero, in the root frame."""
-        transforms = link_transforms_at_rest(self)
+    def rest_aabb(self, positions: Mapping[str, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Bounds of every collision shape with all joints at zero (or at ``positions``:
+        joint name -> rad or m, the others at zero), in the root frame."""
+        transforms = link_transforms_at_rest(self, positions)
         boxes = []
         for link in self.links:
             for shape in link.collision:
@@ -80,18 +81,36 @@ def parse_urdf(
     return structure
 
 
-def link_transforms_at_rest(structure: UrdfStructure) -> dict[str, np.ndarray]:
-    """4×4 transform of every link in the root link's frame, all joints at zero."""
+def link_transforms_at_rest(structure: UrdfStructure,
+                            positions: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
+    """4×4 transform of every link in the root link's frame, all joints at zero (or at
+    ``positions``, joint name -> rad for a revolute joint, m for a prismatic one)."""
     transforms = {structure.root_link: np.eye(4)}
     pending = list(structure.joints)
+    positions = positions or {}
     while pending:
         ready = [j for j in pending if j.parent in transforms]
         for joint in ready:
-            transforms[joint.child] = transforms[joint.parent] @ pose_matrix(joint.origin)
+            transforms[joint.child] = (transforms[joint.parent] @ pose_matrix(joint.origin)
+                                       @ _joint_motion(joint, positions.get(joint.name, 0.0)))
             pending.remove(joint)
         if not ready:  # pragma: no cover - _check_tree rules this out
             raise UrdfError("URDF joints do not connect every link to the root")
     return transforms
+
+
+def _joint_motion(joint: Joint, position: float) -> np.ndarray:
+    """The 4×4 motion of a joint's child frame at ``position`` about or along its axis."""
+    motion = np.eye(4)
+    if position == 0.0 or joint.type == "fixed":
+        return motion
+    axis = np.asarray(joint.axis, dtype=np.float64)
+    axis = axis / np.linalg.norm(axis)
+    if joint.type == "prismatic":
+        motion[:3, 3] = axis * position
+    else:
+        motion[:3, :3] = axis_angle_matrix(axis, position)
+    return motion
 
 
 # --- elements -----------------------------------------------------------------------------

@@ -190,3 +190,15 @@ def test_a_part_starts_open_by_the_fraction_asked(kind):
     assert build_asset(kind).start_positions() == {joint: pytest.approx(lower)}
     assert build_asset(kind, {"open": 0.25}).start_positions() == {
         joint: pytest.approx(lower + 0.25 * (upper - lower))}
+
+
+def test_the_bounds_hold_a_part_that_starts_open():
+    shut = build_asset("drawer_cabinet", {"travel": 0.1})
+    opened = build_asset("drawer_cabinet", {"travel": 0.1, "open": 0.8})
+    # the drawer slides out along -x by 8 cm: the bounds reach that much further
+    shut_lo = shut.bounds.center[0] - shut.bounds.half_extents[0]
+    open_lo = opened.bounds.center[0] - opened.bounds.half_extents[0]
+    assert open_lo == pytest.approx(shut_lo - 0.08)
+    assert opened.bounds.half_extents[1:] == pytest.approx(shut.bounds.half_extents[1:])
+    lid = build_asset("lidded_box", {"open": 0.9})
+    assert lid.bounds.half_extents[2] > 2 * build_asset("lidded_box").bounds.half_extents[2]
