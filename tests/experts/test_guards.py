@@ -77,3 +77,26 @@ def test_a_bottle_too_wide_for_the_hand_is_lifted_by_its_neck(tmp_path):
     result = rollout(_write(tmp_path, "neck", NECK), "careful")
     assert result.safe_success, result.summary()
     assert "squeeze" in result.segments or "close" in result.segments
+
+
+BESIDE_VASE = """\
+scenario press_beside_vase
+  suite boundary
+  task press(object=button)
+  embodiment panda
+  instruction "Press the green button."
+  horizon 20 s
+
+  object button: block(size=(4 cm, 4 cm, 2.5 cm), mass=0.3 kg, color=green) at (10 cm, 0)
+  hazard vase: fragile(vase(radius=4 cm, height=15 cm)) at (10 cm, 12 cm)
+    keep gripper outside 3 cm warn 2 cm
+
+  success pressed(button) for 0.5 s
+"""
+
+
+def test_careful_press_turns_the_hand_away_from_a_hazard_beside_the_button(tmp_path):
+    # a hand lying along y (the default) reaches 10.5 cm each way: into the vase's keep-out
+    result = rollout(_write(tmp_path, "beside", BESIDE_VASE), "careful")
+    assert result.safe_success, result.summary()
+    assert result.min_margin["vase"] > 0.0

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..motion import Guard, Pose, Segment
-from ..skills import DOWN, UP, Plan, nearest_arm, transit
+from ..skills import DOWN, UP, Plan, branch_for_path, nearest_arm, transit
 from ..style import Style
 from ..world import World
-from .common import retreat_home
+from .common import HAND_HALF_LENGTH, retreat_home
 
 #: Force (N) the careful press stops at where no limit watches the press.
 PRESS_FORCE = 10.0
@@ -38,7 +38,7 @@ def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
     lo, hi = world.bounds(obj)
     top = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.005])
     arm = nearest_arm(world, top)
-    R = world.grasp_frame(arm, DOWN, np.array([0.0, 1.0, 0.0]))
+    R = _press_frame(world, style, arm, obj, top)
     yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
     yield from transit(world, style, arm, Pose(top + 0.08 * UP, R), exclude=(obj,))
     if style.avoid_hazards:  # down until the hand feels the press force, then hold
@@ -63,6 +63,40 @@ def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
         yield Segment({arm: Pose(top - np.array([0.0, 0.0, 0.01]), R)},
                       speed=style.contact_speed, settle=20, label="press")
     yield from retreat_home(world, style, arm)
+
+
+def _press_frame(world: World, style: Style, arm: str, obj: str, top: np.ndarray) -> np.ndarray:
+    """The hand pointing down over ``top``, its long (closing) axis along y; careful: turned
+    about the vertical (by 45° steps) to where the hand's two ends stay farthest from the
+    hazards and the other objects beside the button (a hand 21 cm long lying across a
+    neighbour comes down on it), among the turns the arm reaches above the top."""
+    default = world.grasp_frame(arm, DOWN, np.array([0.0, 1.0, 0.0]))
+    if not style.avoid_hazards:
+        return default
+    boxes = [(o.lo, o.hi, o.margin) for o in world.obstacles(exclude=(obj,))]
+    for body in world.scene.bodies:
+        if body.name not in (obj, "table"):
+            lo, hi = world.bounds(body.name)
+            boxes.append((lo, hi, 0.0))
+    if not boxes:
+        return default
+    level = top + HAND_ABOVE * UP  # the hand's body, just above the top
+    best: tuple[float, np.ndarray] | None = None
+    for yaw in np.deg2rad([90.0, 45.0, 0.0, 135.0]):  # y first: the default
+        closing = np.array([np.cos(yaw), np.sin(yaw), 0.0])
+        R = world.grasp_frame(arm, DOWN, closing)
+        if branch_for_path(world, arm, (Pose(top + 0.05 * UP, R),)) is None:
+            continue
+        ends = (level + HAND_HALF_LENGTH * closing, level - HAND_HALF_LENGTH * closing)
+        clearance = min(float(np.linalg.norm(np.maximum(0.0, np.maximum(lo - p, p - hi)))) - margin
+                        for lo, hi, margin in boxes for p in ends)
+        if best is None or clearance > best[0] + 0.005:
+            best = (clearance, R)
+    return default if best is None else best[1]
+
+
+#: How far above the pressed top (m) the hand's body is measured for clearance.
+HAND_ABOVE = 0.03
 
 
 __all__ = ["LEAST_PRESS", "PRESS_FORCE", "plan_press", "press_force"]
