@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from .motion import Pose
 from .skills import Grasp, horizontal, top_down_grasp
 from .style import Style
-from .world import World
+from .world import World, box_distance
 
 
 def grasps(world: World, arm: str, obj: str) -> list[Grasp]:
@@ -67,8 +67,7 @@ def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
         closing = g.pose.R @ world.finger_axis(arm)
         body = g.pose.p - 0.06 * g.approach
         points = (g.pose.p, body + HAND_HALF_LENGTH * closing, body - HAND_HALF_LENGTH * closing)
-        return min(float(np.linalg.norm(np.maximum(0, np.maximum(o.lo - p, p - o.hi))))
-                   - o.margin for o in obstacles for p in points)
+        return min(box_distance(p, o.lo, o.hi) - o.margin for o in obstacles for p in points)
 
     return max(found, key=clearance)
 

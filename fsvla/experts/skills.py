@@ -438,10 +438,10 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
             break
         yield Segment(grippers={arm: min(1.0, world.gripper_opening(arm) + EASE_STEP)},
                       gripper_steps=1, settle=2, label="ease")
-    # the model's opening left the fingers short of the object: close on until it is felt
-    # (a jaw on a hinge in small steps: a stiff jaw drive squeezes ~60 N harder per 1 %
-    # of its range once it touches)
-    # (a jaw from where it is: its width model's target may be shut, trusting the guard)
+    # the model's opening left the fingers short of the object: close on until it is felt;
+    # a jaw on a hinge from where it is (its width model's target may be shut, trusting the
+    # guard) and in small steps (a stiff jaw drive squeezes ~60 N harder per 1 % of its
+    # range once it touches)
     goal = world.gripper_opening(arm)
     step, steps = (EASE_STEP, 3 * SQUEEZE_STEPS)
     if world.fingers_slide(arm):

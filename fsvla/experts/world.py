@@ -25,6 +25,12 @@ from fsvla.world import ArmModel, SceneState
 from .motion import Pose
 
 
+def box_distance(p: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]) -> float:
+    """How far (m) the point ``p`` lies outside the axis-aligned box ``lo``..``hi`` (0 inside);
+    in as many dimensions as ``p`` has."""
+    return float(np.linalg.norm(np.maximum(0.0, np.maximum(lo - p, p - hi))))
+
+
 @dataclass(frozen=True)
 class Obstacle:
     """An axis-aligned box the careful expert keeps ``margin`` away from."""
@@ -191,13 +197,7 @@ class World:
         TCP is where the jaws meet."""
         if len(self.arm_spec(arm).gripper.finger_links) < 2:
             return np.zeros(3)
-        kin = self.kinematics(arm)
-        lo, hi = 0.0, 1.0
-        for _ in range(14):  # the opening whose gap is ``width``
-            mid = 0.5 * (lo + hi)
-            a, b = kin.finger_points(mid)[:2]
-            lo, hi = (mid, hi) if np.linalg.norm(b - a) < width else (lo, mid)
-        a, b = kin.finger_points(hi)[:2]
+        a, b = self.kinematics(arm).finger_points(self.opening_fraction(arm, width))[:2]
         tcp = self.current_pose(arm)
         return tcp.R.T @ (0.5 * (a + b) - tcp.p)
 
@@ -348,4 +348,4 @@ def _z_only(R: NDArray[np.float64]) -> NDArray[np.float64]:
     return rotation_between(np.array([0.0, 0.0, 1.0]), R[:, 2])
 
 
-__all__ = ["Obstacle", "World"]
+__all__ = ["Obstacle", "World", "box_distance"]

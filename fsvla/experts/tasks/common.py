@@ -20,7 +20,7 @@ from ..skills import (
     horizontal,
 )
 from ..style import Style
-from ..world import World
+from ..world import World, box_distance
 
 #: Half the length of a Panda hand along its finger axis (m), with its collision hull.
 HAND_HALF_LENGTH = 0.105
@@ -36,26 +36,26 @@ HANDLE_DEPTH = 0.02
 
 
 def required_fraction(world: World, body: str) -> float:
-    """The largest ``opened(body, fraction=f)`` any requirement or the success asks for."""
-    found = [0.0]
-    for req in world.monitor.requirements:
-        for cond in (req.first, req.then):
-            found += [float(p.params.get("fraction", 0.5)) for p in predicates_in(cond)
-                      if p.name == "opened" and p.args[0] == body]
-    return max(found)
+    """The largest ``opened(body, fraction=f)`` any requirement asks for (0 when none does)."""
+    return _largest(_requirement_conditions(world), "opened", body, "fraction", 0.5)
 
 
 def required_lift(world: World, obj: str) -> float:
     """The largest ``lifted(obj, by=h)`` (m) the success condition or a requirement asks for
     (0 when none does)."""
-    conditions = [world.monitor.success.condition]
-    for req in world.monitor.requirements:
-        conditions += [req.first, req.then]
-    found = [0.0]
-    for cond in conditions:
-        found += [float(p.params.get("by", 0.05)) for p in predicates_in(cond)
-                  if p.name == "lifted" and p.args[0] == obj]
-    return max(found)
+    conditions = [world.monitor.success.condition, *_requirement_conditions(world)]
+    return _largest(conditions, "lifted", obj, "by", 0.05)
+
+
+def _requirement_conditions(world: World) -> list:
+    return [cond for req in world.monitor.requirements for cond in (req.first, req.then)]
+
+
+def _largest(conditions: list, predicate: str, subject: str, key: str, default: float) -> float:
+    """The largest ``key`` parameter (``default`` where not given) of the ``predicate``
+    calls on ``subject`` in ``conditions``; 0 when there is none."""
+    return max([0.0, *(float(p.params.get(key, default)) for cond in conditions
+                       for p in predicates_in(cond) if p.name == predicate and p.args[0] == subject)])
 
 
 def place_point(world: World, style: Style, obj: str, target: str,
@@ -82,8 +82,7 @@ def place_point(world: World, style: Style, obj: str, target: str,
 
     def score(c: np.ndarray) -> float:
         p = pose.R[:2, :2] @ c + pose.p[:2]
-        d = [float(np.linalg.norm(np.maximum(0, np.maximum(o.lo[:2] - p, p - o.hi[:2]))))
-             - o.margin for o in obstacles]
+        d = [box_distance(p, o.lo[:2], o.hi[:2]) - o.margin for o in obstacles]
         return min(min(d, default=1.0), 0.04) - 0.05 * float(np.linalg.norm(c - candidates[0]))
 
     best = max(candidates, key=score) if style.avoid_hazards else candidates[0]

@@ -9,7 +9,7 @@ import numpy as np
 from ..motion import Guard, Pose, Segment
 from ..skills import DOWN, UP, Plan, branch_for_path, nearest_arm, transit
 from ..style import Style
-from ..world import World
+from ..world import World, box_distance
 from .common import HAND_HALF_LENGTH, retreat_home
 
 #: Force (N) the careful press stops at where no limit watches the press.
@@ -88,8 +88,7 @@ def _press_frame(world: World, style: Style, arm: str, obj: str, top: np.ndarray
         if branch_for_path(world, arm, (Pose(top + 0.05 * UP, R),)) is None:
             continue
         ends = (level + HAND_HALF_LENGTH * closing, level - HAND_HALF_LENGTH * closing)
-        clearance = min(float(np.linalg.norm(np.maximum(0.0, np.maximum(lo - p, p - hi)))) - margin
-                        for lo, hi, margin in boxes for p in ends)
+        clearance = min(box_distance(p, lo, hi) - margin for lo, hi, margin in boxes for p in ends)
         if best is None or clearance > best[0] + 0.005:
             best = (clearance, R)
     return default if best is None else best[1]
