@@ -25,7 +25,7 @@ import jinja2
 
 from .geometry import bounds_of, inertia_tensor, union_aabb
 from .materials import PLASTIC, WOOD, Substance, physics_material
-from .model import ArticulatedAsset, BoxShape, ParamValue, Part, Pose, Rgba
+from .model import ArticulatedAsset, BoxShape, ParamValue, Part, Pose, Rgba, start_positions
 from .urdf import parse_urdf
 
 TEMPLATE_DIR = Path(__file__).parent / "templates"
@@ -121,10 +121,8 @@ def _assemble(
     # so that layouts keep clutter and other objects out of an open drawer's way
     shut = structure.rest_aabb()
     lo, hi = shut
-    fraction = float(params.get("open", 0.0) or 0.0)
-    if fraction > 0.0:
-        start = {j.name: j.lower + fraction * (j.upper - j.lower)
-                 for j in structure.joints if j.name in parts.values()}
+    start = start_positions(structure.joints, list(parts.values()), params)
+    if start:
         lo, hi = union_aabb([shut, structure.rest_aabb(start)])
     bounds, footprint = bounds_of(lo, hi)
     total_mass = sum(link.mass for link in structure.links)

@@ -23,6 +23,7 @@ Conventions, shared by every asset:
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping, Sequence
 from typing import Annotated, Any, Literal
 
 from fsvla.dsl.models import versioned_json_schema
@@ -239,6 +240,18 @@ class Part(_Model):
     joint: str
 
 
+def start_positions(joints: Sequence[Joint], moving: Sequence[str],
+                    params: Mapping[str, Any]) -> dict[str, float]:
+    """Joint name -> the position (rad or m) an articulated body starts at, with the asset's
+    ``open`` fraction: each joint of ``moving`` (its parts' joints) that fraction of the way
+    from its lower limit to its upper. Empty without ``open`` (or at 0): every joint then
+    starts at 0, as do the joints not named here."""
+    fraction = float(params.get("open", 0.0) or 0.0)
+    if fraction <= 0.0:
+        return {}
+    return {j.name: j.lower + fraction * (j.upper - j.lower) for j in joints if j.name in moving}
+
+
 class ArticulatedAsset(_Model):
     """An articulated body described by a URDF (inline text or a file) plus its structure."""
 
@@ -265,13 +278,8 @@ class ArticulatedAsset(_Model):
         return self
 
     def start_positions(self) -> dict[str, float]:
-        """The joint positions the body starts at (joint name -> rad or m): each part's
-        joint ``open`` (the asset's parameter, 0 when absent) of the way from its lower
-        limit to its upper; joints not named here start at 0."""
-        fraction = float(self.params.get("open", 0.0) or 0.0)
-        joints = {j.name: j for j in self.joints}
-        return {p.joint: joints[p.joint].lower + fraction * (joints[p.joint].upper - joints[p.joint].lower)
-                for p in self.parts if p.joint in joints}
+        """The joint positions the body starts at (:func:`start_positions`)."""
+        return start_positions(self.joints, [p.joint for p in self.parts], self.params)
 
     def part(self, name: str) -> Part:
         found = next((p for p in self.parts if p.name == name), None)

@@ -187,7 +187,7 @@ def test_generated_urdf_validates_with_yourdfpy_when_installed(kind):
 def test_a_part_starts_open_by_the_fraction_asked(kind):
     part, _type, lower, upper = EXPECTED[kind]
     joint = build_asset(kind).part(part).joint
-    assert build_asset(kind).start_positions() == {joint: pytest.approx(lower)}
+    assert build_asset(kind).start_positions() == {}  # without `open`: every joint at 0
     assert build_asset(kind, {"open": 0.25}).start_positions() == {
         joint: pytest.approx(lower + 0.25 * (upper - lower))}
 
@@ -202,3 +202,12 @@ def test_the_bounds_hold_a_part_that_starts_open():
     assert opened.bounds.half_extents[1:] == pytest.approx(shut.bounds.half_extents[1:])
     lid = build_asset("lidded_box", {"open": 0.9})
     assert lid.bounds.half_extents[2] > 2 * build_asset("lidded_box").bounds.half_extents[2]
+
+
+def test_without_open_a_joint_whose_range_starts_below_zero_starts_at_zero():
+    from fsvla.compiler.assets.model import Joint, start_positions
+
+    joints = [Joint(name="hinge", type="revolute", parent="a", child="b", lower=-1.0, upper=1.0)]
+    assert start_positions(joints, ["hinge"], {}) == {}
+    assert start_positions(joints, ["hinge"], {"open": 0.5}) == {"hinge": pytest.approx(0.0)}
+    assert start_positions(joints, ["hinge"], {"open": 1.0}) == {"hinge": pytest.approx(1.0)}
