@@ -76,12 +76,15 @@ ROLE_ASSETS: dict[str, dict[str, tuple[str, ...]]] = {
     "bimanual_lift": {"object": ("pot",)},
     "handover": {"object": ("block",)},
 }
-#: Tasks with a precondition the ``temporal`` suite can state.
-PRECONDITIONS = frozenset({"pick_place", "lift", "stack", "insert", "pour", "bimanual_lift",
-                           "handover"})
+#: Tasks with a precondition the ``temporal`` suite can state, one a hurried robot can
+#: break (a lift or a pour cannot come before its grasp: "grasped before lifted" holds for
+#: any rollout, and is no hazard).
+PRECONDITIONS = frozenset({"pick_place", "stack", "insert", "bimanual_lift", "handover"})
 TABLE_HALF = (0.6, 0.4)  # the default table's half size (m)
 GAP = 0.03  # between objects' footprints (m)
 BASE_CLEARANCE = 0.15  # from a robot's mount to an object's footprint (m)
+HAND_ROOM = 0.1  # in front of an opened part, for the hand that pushes it shut (m)
+HAND_SPAN = 0.06  # around the TCP, for the hand and fingers (m)
 MAX_ATTEMPTS = 64  # draws checked (``fsvla check``, layouts) before giving up
 PLACEMENT_ATTEMPTS = 4096  # draws tried in all, most rejected by placement alone
 
@@ -204,6 +207,8 @@ class _Body:
     yaw: float = 0.0  # deg
     role: str | None = None  # hazard role, e.g. fragile
     keeps: list[str] = field(default_factory=list)
+    depth: float = 0.0  # an articulated body's size along x (m)
+    sweep: float = 0.0  # how far its opening part comes out toward the robot (m)
 
 
 def _cm(metres: float) -> str:
@@ -326,7 +331,7 @@ class _Draw:
             size = tuple(float(v) * scale * u(0.85, 1.0) for v in default)  # type: ignore[union-attr]
             travel = ""
             if kind == "drawer_cabinet":
-                travel = f", travel={_cm(min(0.2, size[0] * 0.5))}"
+                travel = f", travel={_cm(_sweep(kind, size))}"
             # a part a `close` task shuts starts open (a hinged one past upright, where it
             # stays; short of that it falls shut by itself)
             start = ""
@@ -334,7 +339,8 @@ class _Draw:
                 start = f", open={u(0.6, 0.9) if kind == 'drawer_cabinet' else 0.9:.2f}"
             call = f"{kind}(size=({_cm(size[0])}, {_cm(size[1])}, {_cm(size[2])}){travel}{start})"
             # the opening part sweeps toward the robot: keep that ground free
-            body = _Body(role, call, kind, math.hypot(size[0], size[1]) / 2 + 0.1 * size[0], size[2])
+            body = _Body(role, call, kind, math.hypot(size[0], size[1]) / 2 + 0.1 * size[0], size[2],
+                         depth=size[0], sweep=_sweep(kind, size))
         else:
             raise ValueError(f"the sampler does not draw {kind}")
         body.name = self._name(kind)
@@ -367,8 +373,12 @@ class _Draw:
             articulated = ASSETS[body.kind].asset_class.value == "articulated"
             for _ in range(50):
                 if articulated:
-                    # its front (toward the robot) within reach, it stands behind
-                    body.x, body.y = rng.uniform(x0 + 0.05, x1), rng.uniform(y0, y1) * 0.5
+                    # its front (toward the robot) within reach, it stands behind; the part
+                    # opened all the way, with the hand in front of it, still inside the
+                    # reach (an open drawer against the arm at home, or pulled out over
+                    # the robot's base, cannot be worked)
+                    front = rng.uniform(min(x0 + body.sweep + HAND_ROOM, x1), x1)
+                    body.x, body.y = front + body.depth / 2, rng.uniform(y0, y1) * 0.5
                     body.yaw = 0.0
                 else:
                     # a target is reached at its nearest point: its centre may stand further out
@@ -436,6 +446,11 @@ class _Draw:
             if any(not self._apart(hazard, b, clear) for b in self.bodies if b is not hazard):
                 continue
             if any(math.hypot(hazard.x - bx, hazard.y - by) < hazard.radius + 0.25 for bx, by in bases):
+                continue
+            # the robot starts outside every warning band (the episode refuses to start)
+            if any(math.hypot(max(0.0, math.hypot(hazard.x - tx, hazard.y - ty) - hazard.radius - HAND_SPAN),
+                              max(0.0, tz - HAND_SPAN - hazard.height)) < clear
+                   for tx, ty, tz in _home_tcps(self.embodiment)):
                 continue
             return
         raise _Infeasible()
@@ -534,15 +549,13 @@ class _Draw:
         target = roles["target"].name if "target" in roles else None
         if self.task == "insert":
             first, then = f"opened({target}, fraction=0.6)", f"inside({obj}, {target})"
-        elif self.task == "pour":
-            first, then = f"grasped({obj})", f"tilted({obj}, by=30 deg)"
         elif self.task == "bimanual_lift":
             first, then = f"grasped({obj}, left) and grasped({obj}, right)", f"lifted({obj}, by=2 cm)"
         elif self.task == "handover":
             first = "aligned(left_gripper, right_gripper, within=15 cm)"
             then = f"grasped({obj}, right)"
-        else:
-            first, then = f"grasped({obj})", f"lifted({obj}, by=2 cm)"
+        else:  # set down, not dropped
+            first, then = f"on({obj}, {target})", f"released({obj})"
         self.lines.append(f"require pre: {first} before {then}")
         self.l2.append(f"couple pre within {self.rng.choice((10, 15, 20))} s")
 
@@ -637,6 +650,33 @@ def _bases(embodiment: str) -> tuple[tuple[float, float], ...]:
 
     spec = load_embodiment(embodiment)
     return tuple((float(r.mount.position[0]), float(r.mount.position[1])) for r in spec.robots)
+
+
+def _sweep(kind: str, size: tuple[float, ...]) -> float:
+    """How far an articulated asset's part comes out in front of it, open all the way (m):
+    a drawer by its travel, a door (three quarters of the front, hinged on one side) by its
+    width; a lid swings up, over the box."""
+    if kind == "drawer_cabinet":
+        return min(0.2, size[0] * 0.5)
+    if kind == "microwave":
+        return 0.75 * size[1]
+    return 0.0
+
+
+@cache
+def _home_tcps(embodiment: str) -> tuple[tuple[float, float, float], ...]:
+    """Where each arm's TCP is at home (m, the table's frame), measured on the robot's
+    model (the one the static checks load)."""
+    from fsvla.embodiments.registry import load_embodiment
+
+    from .robots import robot_model
+
+    model = robot_model(load_embodiment(embodiment))
+    found = []
+    for arm in model.arms:
+        p = model.robot.arm(arm).tcp_pose().p
+        found.append((float(p[0]), float(p[1]), float(p[2])))
+    return tuple(found)
 
 
 def _segment_distance(p: Sequence[float], a: Sequence[float], b: Sequence[float]) -> float:

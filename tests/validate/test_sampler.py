@@ -124,3 +124,30 @@ def test_sampled_scenarios_roll_out_as_recorded_outcomes(tmp_path: Path) -> None
             assert row.failure_reason != "sim_error", (row.key.scenario, row.failure_detail)
             if row.status == "faulted":
                 assert row.failure_detail, row
+
+
+@pytest.mark.sim
+@given(seed=SEEDS, task=st.sampled_from(("press", "push", "lift", "open", "close", "pick_place")))
+@settings(max_examples=8, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+def test_a_draw_starts_outside_every_warning_band(tmp_path: Path, seed: int, task: str) -> None:
+    """The robot at home, held still, is outside every warning band at every level: an
+    episode whose layout starts inside one refuses to start (FSV604), so a hazard drawn
+    beside the arm's home pose (a hot kettle under a Z1's hand) is no scenario."""
+    from fsvla.env import make
+    from fsvla.policies.simple import hold_action
+
+    sampled = sample_scenario(seed, task=task, deep=False)
+    path = tmp_path / sampled.filename()
+    path.write_text(sampled.text, encoding="utf-8")
+    for level in ("L0", "L1", "L2"):
+        env = make(str(path), level, seed)
+        try:
+            observation, _ = env.reset()
+            arms = len(observation["agent"]["gripper"])
+            hold = hold_action(observation, "joint_pos", [len(observation["agent"]["qpos"]) // arms] * arms)
+            for _ in range(5):
+                observation, _, _, _, info = env.step(hold)
+                assert [c for c, s in info["states"].items() if s != "safe"] == [], (level, sampled.text)
+        finally:
+            env.close()
