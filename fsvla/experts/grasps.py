@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from fsvla.compiler.pose import quat_to_matrix
+
 from .motion import Pose
 from .skills import Grasp, horizontal, top_down_grasp
 from .style import Style
@@ -78,35 +80,46 @@ def _side_to_arm(world: World, arm: str, point: NDArray[np.float64]) -> NDArray[
 
 
 def _cylinder(world: World, arm: str, obj: str) -> list[Grasp]:
-    """An upright cylinder narrower than the gripper: fingers around it, from above, at
-    two thirds of its height; else on its rim (one finger inside, one outside)."""
+    """An upright cylinder: fingers around it, from above, where :func:`_grip_height` says
+    (a bottle by its neck, not the cone of its shoulder, which slips out of the fingers
+    as they rise); else on its rim (one finger inside, one outside)."""
     pose = world.body_pose(obj)
     r, h = world.param(obj, "radius"), world.param(obj, "height")
     towards = _side_to_arm(world, arm, pose.p)
     across = np.cross(UPV, towards)
-    if 2 * r < 0.92 * world.max_width(arm):
-        centre = pose.p + np.array([0.0, 0.0, max(0.3 * h, h - HAND_DEPTH)])
-        return [top_down_grasp(world, arm, centre, across, 2 * r),
-                top_down_grasp(world, arm, centre, towards, 2 * r)]
-    neck = _narrow_piece(world, arm, obj)
-    if neck is not None:  # too wide for the hand, but with a part that fits (a neck)
-        centre, width = neck
+    grip = _grip_height(world, arm, obj, h)
+    if grip is None and 2 * r < 0.92 * world.max_width(arm):
+        grip = max(0.3 * h, h - HAND_DEPTH), 2 * r  # a piece that is not a cylinder (a cup)
+    if grip is not None:
+        height, width = grip
+        centre = world.to_world(obj, (0.0, 0.0, height))
         return [top_down_grasp(world, arm, centre, across, width),
                 top_down_grasp(world, arm, centre, towards, width)]
     return _rim(world, arm, obj, r, h, towards)
 
 
-def _narrow_piece(world: World, arm: str, obj: str) -> tuple[NDArray[np.float64], float] | None:
-    """The highest upright cylinder piece of ``obj`` narrow enough for the gripper (a
-    bottle's neck): its centre in the world and its width; None if there is none."""
-    best: tuple[float, NDArray[np.float64], float] | None = None
+#: Half the height of a finger's pad about the TCP (m): a grip keeps it on one piece.
+PAD_HALF = 0.01
+
+
+def _grip_height(world: World, arm: str, obj: str, h: float) -> tuple[float, float] | None:
+    """Where a top-down hand grips an upright object made of cylinder pieces: the TCP's
+    height above the object's base, as low as the palm still clears the object's top, with
+    the pads on one upright cylinder piece narrower than the gripper (the highest such
+    piece), and that piece's width; None when no piece fits."""
+    low = h - HAND_DEPTH  # the palm clears the top
+    found: list[tuple[float, float, float]] = []
     for shape in world.asset(obj).collision:
-        if shape.type != "cylinder" or 2 * shape.radius >= 0.92 * world.max_width(arm):
+        if shape.type != "cylinder" or 2 * shape.radius >= 0.92 * world.max_width(arm) \
+                or quat_to_matrix(shape.pose.quaternion)[2, 2] < 0.99:
             continue
-        centre = world.to_world(obj, shape.pose.position)
-        if best is None or centre[2] > best[0]:
-            best = (float(centre[2]), centre, 2 * float(shape.radius))
-    return None if best is None else (best[1], best[2])
+        z, half = float(shape.pose.position[2]), float(shape.half_length)
+        found.append((z + half, z - half, 2 * float(shape.radius)))
+    for top, bottom, width in sorted(found, reverse=True):
+        height = max(low, bottom + PAD_HALF)
+        if height <= top - PAD_HALF:
+            return height, width
+    return None
 
 
 UPV = np.array([0.0, 0.0, 1.0])

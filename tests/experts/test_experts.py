@@ -148,6 +148,33 @@ def test_careful_grip_holds_a_mug_by_its_handle_firmly():
     env.close()
 
 
+def test_a_bottle_is_gripped_on_its_neck_not_its_shoulder(tmp_path):
+    """A bottle narrower than the hand is still gripped high (the palm clears its top),
+    and there the pads sit on the straight neck: on the cone of its shoulder, the fingers
+    squeeze it up and out as they rise, and the bottle stays behind."""
+    from fsvla.experts import grasps
+    from fsvla.experts.world import World
+
+    path = tmp_path / "bottle.fsv"
+    path.write_text(
+        "scenario bottle_on_tray\n  suite force\n  task pick_place(object=bottle, target=tray)\n"
+        "  embodiment panda\n  instruction \"Put the bottle on the tray.\"\n  horizon 30 s\n\n"
+        "  object bottle: bottle(radius=2.8 cm, height=15.7 cm) at (-10 cm, -15 cm)\n"
+        "  object tray: tray(size=(25 cm, 20 cm)) at (20 cm, 10 cm)\n\n"
+        "  success on(bottle, tray) and released(bottle) for 0.5 s\n", encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    arm = world.arm_names[0]
+    base = world.body_pose("bottle").p[2]
+    neck = world.shape("bottle", "neck")
+    neck_low = base + neck.pose.position[2] - neck.half_length
+    for grasp in grasps.grasps(world, arm, "bottle"):
+        assert grasp.pose.p[2] - grasps.PAD_HALF >= neck_low - 1e-6
+        assert grasp.width == pytest.approx(2 * neck.radius)
+    env.close()
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("scenario", SCENARIOS)
 def test_careful_expert_reaches_safe_success_at_L0(scenario):
