@@ -2,13 +2,22 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+from numpy.typing import NDArray
+
+from fsvla.compiler.pose import quat_to_matrix, rotation_angle
 
 from .. import grasps
 from ..motion import Pose, Segment
 from ..skills import (
+    CARRY_SPEED,
     UP,
+    Grasp,
     Plan,
+    branch_for_path,
+    clear_height,
     free_speed,
     grasp_lever,
     grip_force,
@@ -22,6 +31,7 @@ from ..skills import (
 )
 from ..style import Style
 from ..world import World
+from .arm_gap import ArmGap
 from .common import place_point, retreat_home
 
 #: An object at least this long (m) is handed over by its two ends, both hands from
@@ -96,39 +106,268 @@ def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
     yield from retreat_home(world, style, taker)
 
 
-def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, taker: str) -> Plan:
-    """A long object: the giver takes the end nearer to it from above, brings the object
-    over the middle (its long axis from arm to arm), the taker takes the other end from
-    above, the giver lets go and backs off, the taker puts it on the support. A Panda can
-    hold out a top-down hand there; a hand pointing sideways at the object it cannot."""
-    shape = world.asset(obj).collision[0]
-    half = np.asarray(shape.half_size, dtype=np.float64)
-    pose = world.body_pose(obj)
-    axis = int(np.argmax(half[:2]))
-    along, across = pose.R[:, axis], pose.R[:, 1 - axis]
-    centre = world.to_world(obj, shape.pose.position)
-    reach = float(half[axis]) - END_GRASP
-    side = 1.0 if along @ (world.base_position(giver) - centre) >= 0 else -1.0
-    lift = np.array([0.0, 0.0, 0.3 * half[2]])
-    width = 2 * float(half[1 - axis])
-    grasp = top_down_grasp(world, giver, centre + side * reach * along + lift, across, width)
-    yield from pick(world, style, giver, obj, grasp)
+def _turn(angle: float) -> NDArray[np.float64]:
+    """Rotation by ``angle`` (rad) about the vertical."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _yaw_between(u: NDArray[np.float64], v: NDArray[np.float64]) -> float:
+    """The signed angle (rad) about the vertical from horizontal ``u`` to ``v``."""
+    return float(np.arctan2(u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1]))
+
+
+def _joints_at(world: World, arm: str, q: NDArray[np.float64], pose: Pose) -> NDArray[np.float64]:
+    """The joints for ``pose`` on ``q``'s branch (a short line away from ``q``'s pose)."""
+    kin = world.kinematics(arm)
+    r = kin.inverse(tuple(pose.p), pose.quat, seed=q, restarts=0, max_iterations=300)
+    return np.asarray(r.qpos, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class _Bar:
+    """A long object's geometry now: its middle, long and short horizontal axes, half
+    sizes (along, across, up), and its own long and up axes (tilted where it has pivoted
+    in a hand)."""
+
+    centre: NDArray[np.float64]
+    along: NDArray[np.float64]
+    across: NDArray[np.float64]
+    half: NDArray[np.float64]
+    line: NDArray[np.float64]
+    up: NDArray[np.float64]
+
+    @classmethod
+    def of(cls, world: World, obj: str) -> _Bar:
+        shape = world.asset(obj).collision[0]
+        half = np.asarray(shape.half_size, dtype=np.float64)
+        R = world.body_pose(obj).R @ quat_to_matrix(np.asarray(shape.pose.quaternion))
+        axis = int(np.argmax(half[:2]))
+        up = R[:, 2] if R[2, 2] >= 0 else -R[:, 2]
+        return cls(world.to_world(obj, shape.pose.position), horizontal(R[:, axis]),
+                   horizontal(R[:, 1 - axis]), np.array([half[axis], half[1 - axis], half[2]]),
+                   R[:, axis].copy(), up.copy())
+
+
+@dataclass(frozen=True)
+class _Exchange:
+    """Where a long object changes hands: its middle there, the inset of the giver's hand
+    from its end, how far from the middle the taker takes it (careful: as far as the giver;
+    careless: at the middle, where it balances, leaving the hands no room apart), 
+    how far before its take pose (along the approach) the taker's free-space move
+    ends (m), and how far the taker's hand leans away from the giver's (rad)."""
+
+    middle: NDArray[np.float64]
+    inset: float
+    take_at: float
+    above: float
+    tilt: float = 0.0
+
+
+#: Insets (m) of the hands from the object's ends, the first preferred; a smaller one
+#: spreads the hands farther apart where a separation limit needs it (a finger pad is
+#: about 2 cm wide).
+INSETS = (END_GRASP, 0.018)
+#: Extra heights (m) of the meeting above the lowest one, and shifts (m) of it ahead of
+#: the robot, tried in turn until the arms keep their separation there.
+MEET_RAISES = (0.0, 0.06, 0.12)
+MEET_SHIFTS = (0.0, 0.06, 0.12)
+#: Distances (m) before its take pose from which the taker comes straight in.
+ABOVE = (0.1, 0.16, 0.22)
+#: Leans (rad) of the taker's hand away from the giver, tried in turn: Baxter's forearms
+#: stand 40 cm tall above hands that point down, and two of them side by side touch.
+TILTS = (0.0, 0.5, 0.9)
+#: Careful: the fastest turn (rad/s) of a hand carrying a long object by its end.
+CARRY_TURN = 0.4
+#: What an exchange that misses a required alignment of the hands loses in rank (m).
+UNALIGNED = 1.0
+#: How much clearance (m) beyond a separation limit's warning band the careful arms keep.
+GAP_SLACK = 0.01
+
+
+def _meeting_options(world: World, style: Style, obj: str, giver: str,
+                     taker: str) -> list[NDArray[np.float64]]:
+    """Where the object's middle may be when it changes hands, the preferred first:
+    :func:`meeting_point` at the height that clears the obstacles, then (careful) higher
+    and farther ahead of the robot, where the arms' links are farther apart."""
     mid = meeting_point(world, giver, taker)
     height = max([o.hi[2] + o.margin + style.hazard_clearance for o in world.obstacles((obj,))]
                  + [0.1]) + 0.12
+    base = np.array([mid[0], mid[1], height])
+    if not style.avoid_hazards:
+        return [base]
+    bases = 0.5 * (world.base_position(giver) + world.base_position(taker))
+    ahead = np.array([mid[0] - bases[0], mid[1] - bases[1], 0.0])
+    toward = horizontal(world.base_position(taker) - world.base_position(giver))
+    ahead -= (ahead @ toward) * toward
+    ahead = ahead / np.linalg.norm(ahead) if np.linalg.norm(ahead) > 1e-6 else None
+    out = []
+    for shift in MEET_SHIFTS:
+        if shift and ahead is None:
+            continue
+        for raise_ in MEET_RAISES:
+            out.append(base + raise_ * UP + (shift * ahead if shift else 0.0))
+    return out
+
+
+def _end_options(bar: _Bar, world: World, giver: str, toward: NDArray[np.float64]) -> list[float]:
+    """The ends (+1: along the long axis, -1: against it) the giver may take, the one its
+    hand turns less to hold the object out toward the taker first (then the nearer)."""
+    def key(e: float) -> tuple[float, float]:
+        turn = abs(_yaw_between(-e * bar.along, toward))
+        near = float(np.linalg.norm((bar.centre + e * bar.along - world.base_position(giver))[:2]))
+        return (round(turn, 3), near)
+
+    return sorted((1.0, -1.0), key=key)
+
+
+def _giver_at_meeting(world: World, giver: str, grip: Pose, centre: NDArray[np.float64],
+                      toward: NDArray[np.float64], middle: NDArray[np.float64]) -> Pose:
+    """The giver's TCP pose that holds the object (gripped at ``grip`` while its middle is
+    at ``centre``) with its middle at ``middle`` and its long axis along ``toward``: the
+    hand turned about the vertical."""
+    turn = _turn(_yaw_between(horizontal(centre - grip.p), toward))
+    return Pose(middle + turn @ (grip.p - centre), turn @ grip.R)
+
+
+def _taker_grasp(world: World, taker: str, bar: _Bar, middle: NDArray[np.float64],
+                 toward: NDArray[np.float64], out: float, tilt: float = 0.0) -> Grasp:
+    """The taker's grasp of the object held out along ``toward`` with its middle at
+    ``middle``, ``out`` (m) from the middle toward the taker: from above, the hand leaning
+    ``tilt`` (rad) away from the giver about the closing axis (the fingers close across
+    the object either way, so the grip holds it alike; the taker's wrist and forearm lean
+    away from the giver's)."""
+    across = np.cross(bar.up, toward)
+    point = middle + out * toward + 0.3 * bar.half[2] * bar.up
+    approach = -np.cos(tilt) * bar.up - np.sin(tilt) * toward
+    R = world.grasp_frame(taker, approach, across)
+    return Grasp(Pose(point, R), 2 * float(bar.half[1]), approach)
+
+
+def _exchange_margin(world: World, gap: ArmGap, giver: str, taker: str, q_giver,
+                     grasp: Grasp, above: float) -> float:
+    """The arms' smallest separation margin (:class:`ArmGap`) while the giver holds still
+    at ``q_giver`` and the taker comes from where it is to ``above`` before ``grasp`` in
+    free space, then straight in onto it, less UNALIGNED where the hands are then farther
+    apart than a requirement's ``aligned`` allows; -inf where the taker cannot."""
+    over = grasp.pose.moved(-above * grasp.approach)
+    q_over = branch_for_path(world, taker, (over, grasp.pose))
+    if q_over is None:
+        return float("-inf")
+    q_now = np.asarray(world.arm_joints(taker), dtype=np.float64)
+    q_take = _joints_at(world, taker, q_over, grasp.pose)
+    margin = min(gap.along(q_giver, q_giver, q_now, q_over),
+                 gap.along(q_giver, q_giver, q_over, q_take, samples=3))
+    # a requirement that the hands come together (aligned) before the take: an exchange
+    # that leaves them too far apart ranks below every one that does not
+    return margin if gap.aligned(q_giver, q_take) else margin - UNALIGNED
+
+
+def _plan_exchange(world: World, style: Style, obj: str, giver: str,
+                   taker: str) -> tuple[float, _Exchange]:
+    """Before the pick: which end the giver takes, and where the hands meet. Careful, with
+    a separation limit on the arms, the first option (end, inset, meeting point, approach
+    height) at which the arms' links keep the limit and its warning band with GAP_SLACK
+    to spare, predicted on the arms' models (else the one that keeps the most); careless,
+    the first end and meeting point, the taker's hand at the middle (no room kept)."""
+    bar = _Bar.of(world, obj)
+    toward = horizontal(world.base_position(taker) - world.base_position(giver))
+    ends = _end_options(bar, world, giver, toward)
+    meetings = _meeting_options(world, style, obj, giver, taker)
+    if not style.avoid_hazards:
+        return ends[0], _Exchange(meetings[0], INSETS[0], 0.0, ABOVE[0])
+    first = (ends[0], _Exchange(meetings[0], INSETS[0], float(bar.half[0]) - INSETS[0], ABOVE[0]))
+    gap = ArmGap(world, giver, taker)
+    if not gap.watched:
+        return first
+    best, best_margin = first, float("-inf")
+    lift = np.array([0.0, 0.0, 0.3 * bar.half[2]])
+    for inset in INSETS:
+        for e in ends:
+            grip = top_down_grasp(world, giver, bar.centre + e * (bar.half[0] - inset) * bar.along
+                                  + lift, bar.across, 2 * float(bar.half[1])).pose
+            for middle in meetings:
+                held = _giver_at_meeting(world, giver, grip, bar.centre, toward, middle)
+                q_giver = branch_for_path(world, giver, (held,))
+                if q_giver is None:
+                    continue
+                for tilt in TILTS:
+                    grasp = _taker_grasp(world, taker, bar, middle, toward,
+                                         float(bar.half[0]) - inset, tilt)
+                    for above in ABOVE:
+                        margin = _exchange_margin(world, gap, giver, taker, q_giver, grasp,
+                                                  above)
+                        if margin > best_margin:
+                            best = (e, _Exchange(middle, inset, float(bar.half[0]) - inset,
+                                                 above, tilt))
+                            best_margin = margin
+                        if margin >= GAP_SLACK:
+                            return best
+    return best
+
+
+def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, taker: str) -> Plan:
+    """A long object: the giver takes one end from above, brings the object over the
+    middle with its long axis from arm to arm (turning its hand about the vertical), the
+    taker takes the other end from above (careless: the middle, beside the giver's hand),
+    the giver lets go and backs off, the taker puts it on the support. A Panda can hold
+    out a top-down hand there; a hand pointing sideways at the object it cannot. Careful,
+    with a separation limit on the arms, the end, the meeting point and the taker's
+    approach (its hand leaning away from the giver's where their forearms would meet) are
+    chosen so that the arms' links keep the limit and its warning band
+    (:func:`_plan_exchange`)."""
+    bar = _Bar.of(world, obj)
+    toward = horizontal(world.base_position(taker) - world.base_position(giver))
+    e, meet = _plan_exchange(world, style, obj, giver, taker)
+    reach = float(bar.half[0]) - meet.inset
+    lift = np.array([0.0, 0.0, 0.3 * bar.half[2]])
+    width = 2 * float(bar.half[1])
+    grasp = top_down_grasp(world, giver, bar.centre + e * reach * bar.along + lift, bar.across,
+                           width)
+    yield from pick(world, style, giver, obj, grasp)
+    # carry: up to the meeting height (or what clears the obstacles on the way), across in
+    # free space turning the hand, down onto the meeting point
     held = world.current_pose(giver)
-    now = world.to_world(obj, shape.pose.position)
-    goal = Pose(np.array([mid[0], mid[1], height]) + (held.p - now), held.R)
-    yield from transit(world, style, giver, goal, below=0.05, exclude=(obj,))
-    now = world.to_world(obj, shape.pose.position)
-    along = world.body_pose(obj).R[:, axis]
-    across = world.body_pose(obj).R[:, 1 - axis]
-    side = 1.0 if along @ (world.base_position(taker) - now) >= 0 else -1.0
-    take = top_down_grasp(world, taker, now + side * reach * along + lift, across, width)
+    now = _Bar.of(world, obj)
+    goal = _giver_at_meeting(world, giver, held, now.centre, toward, meet.middle)
+    below = float(held.p[2] - (now.centre[2] - now.half[2])) + 0.03
+    height = max(clear_height(world, style, held.p, goal.p, below, (obj,),
+                              around=float(now.half[0])), goal.p[2])
+    if height > held.p[2] + 1e-3:
+        yield Segment({giver: Pose(np.array([held.p[0], held.p[1], height]), held.R)},
+                      speed=style.transit_speed, label="up")
+    over = Pose(np.array([goal.p[0], goal.p[1], height]), goal.R)
+    q = branch_for_path(world, giver, (over, goal))
+    # careful: a long object held by its end pivots in the fingers when the hand turns it
+    # fast; the turn takes at least its angle / CARRY_TURN
+    speed = style.transit_speed
+    if style.avoid_hazards:
+        turn = rotation_angle(held.R, over.R)
+        dist = float(np.linalg.norm(over.p - np.array([held.p[0], held.p[1], height])))
+        speed = min(speed, CARRY_SPEED, max(dist, 0.01) * CARRY_TURN / max(turn, 1e-3))
+    yield Segment({giver: over}, speed=speed, label="across", joint_space=True,
+                  branch_of={giver: goal}, joints={giver: q} if q is not None else {})
+    yield Segment({giver: goal}, speed=min(speed, style.approach_speed), label="down")
+    # the taker: free space to above the far end, straight down onto it
+    # aimed at the object as it is now (it may have pivoted a little in the giver's hand)
+    now = _Bar.of(world, obj)
+    line = now.line if now.line @ toward >= 0 else -now.line
+    take = _taker_grasp(world, taker, now, now.centre, line, meet.take_at, meet.tilt)
+    above = meet.above
+    gap = ArmGap(world, giver, taker)
+    if style.avoid_hazards and gap.watched:
+        q_giver = np.asarray(world.arm_joints(giver), dtype=np.float64)
+        margins = {h: _exchange_margin(world, gap, giver, taker, q_giver, take, h)
+                   for h in dict.fromkeys((meet.above, *ABOVE))}
+        above = next((h for h, m in margins.items() if m >= GAP_SLACK),
+                     max(margins, key=margins.__getitem__))
     yield Segment(grippers={taker: 1.0}, gripper_steps=style.gripper_steps, label="open taker")
-    yield from transit(world, style, taker, take.pose.moved(0.1 * UP), exclude=(obj,),
-                       then=take.pose)
-    yield Segment({taker: take.pose.moved(0.02 * UP)}, speed=style.approach_speed, label="to end")
+    over = take.pose.moved(-above * take.approach)
+    q = branch_for_path(world, taker, (over, take.pose))
+    yield Segment({taker: over}, speed=style.transit_speed, label="across", joint_space=True,
+                  branch_of={taker: take.pose}, joints={taker: q} if q is not None else {})
+    yield Segment({taker: take.pose.moved(-0.02 * take.approach)}, speed=style.approach_speed,
+                  label="to end")
     yield Segment({taker: take.pose}, speed=0.5 * style.approach_speed, label="to end")
     # the taker ends up holding the object alone, by its end: firm enough not to pivot
     gripped = grip_force(world, obj, style, lever=grasp_lever(world, taker, obj, take.pose))
@@ -144,7 +383,7 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
     support = next((b.name for b in world.scene.bodies if b.name not in ("table", obj)
                     and getattr(b.asset, "support_height", None) is not None), None)
     spot = (place_point(world, style, obj, support) if support is not None
-            else np.array([mid[0], mid[1], 0.0]))
+            else np.array([meet.middle[0], meet.middle[1], 0.0]))
     # let go with the fingers 1 cm clear: no contact flicker that reads as a new grasp
     yield from place(world, style, taker, obj, spot, release_gap=0.01)
     yield from retreat_home(world, style, taker)

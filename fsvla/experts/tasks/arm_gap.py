@@ -1,0 +1,189 @@
+"""How far apart two arms' links are, for joint configurations of both: what a
+``separation`` limit between two arms (or their grippers) measures, so that a two-arm plan
+can choose where the hands meet, and the joints they meet with, before it moves.
+
+The monitor measures the smallest signed distance between the link geometry of two robot
+entities (``fsvla.monitor.channels``). :class:`ArmGap` does the same on the arms' models:
+each watched link is one convex hull of its collision pieces' vertices (which fills a
+link's concavities in: an under-estimate of the distance, on the safe side), posed by the
+arm's forward kinematics, and measured with FCL as the monitor does. The fingers stay
+where they are now (the arm joints do not move them relative to the hand).
+"""
+
+from __future__ import annotations
+
+import fcl
+import numpy as np
+from numpy.typing import NDArray
+
+from fsvla.compiler.collision import convex_geometry, signed_distance
+from fsvla.compiler.monitor import RobotEntity
+from fsvla.compiler.pose import quat_to_matrix
+from fsvla.dsl.models import predicates_in
+
+from ..world import World
+
+#: Joint offset (rad) that tells which arm's joints move a link.
+_PROBE = 0.3
+
+
+def _piece(shape) -> tuple[fcl.CollisionGeometry, NDArray[np.float64]] | None:
+    """A simulator collision shape as FCL geometry and its pose in its link: a convex
+    mesh as its hull, a box or sphere as itself, a capsule or cylinder as its bounding
+    box (an over-estimate, on the safe side)."""
+    local = np.eye(4)
+    pose = shape.local_pose
+    local[:3, :3] = quat_to_matrix(np.asarray(pose.q, dtype=np.float64))
+    local[:3, 3] = np.asarray(pose.p, dtype=np.float64)
+    if hasattr(shape, "get_vertices"):
+        v = np.asarray(shape.get_vertices(), dtype=np.float64) * np.asarray(shape.scale)
+        return (convex_geometry(v), local) if len(v) >= 4 else None
+    if hasattr(shape, "half_size"):
+        return fcl.Box(*(2.0 * np.asarray(shape.half_size, dtype=np.float64))), local
+    if hasattr(shape, "half_length"):  # along x in SAPIEN
+        r = float(shape.radius)
+        return fcl.Box(2.0 * (float(shape.half_length) + r), 2.0 * r, 2.0 * r), local
+    if hasattr(shape, "radius"):
+        return fcl.Sphere(float(shape.radius)), local
+    return None
+
+
+class ArmGap:
+    """Smallest (distance − (limit + warning band)) between the links of arms ``a`` and
+    ``b`` over the ``separation`` channels that watch the two (m); ``None`` channels: no
+    such limit, and :meth:`margin` is +inf."""
+
+    def __init__(self, world: World, a: str, b: str) -> None:
+        self.world = world
+        self.arms = (a, b)
+        self.kin = {arm: world.kinematics(arm) for arm in self.arms}
+        robot_of = {arm.name: robot.name for robot in world.scene.embodiment.robots
+                    for arm in robot.arms}
+        entities = {e.name: e for e in world.monitor.entities if isinstance(e, RobotEntity)}
+        owner = {arm: self._moved_links(arm) for arm in self.arms}
+        self._checks: list[tuple[list[int], list[int], float]] = []
+        #: (arm, link index) -> the link's collision pieces: (FCL geometry, pose in the link)
+        self._geometry: dict[tuple[str, int], list[tuple[fcl.CollisionGeometry,
+                                                          NDArray[np.float64]]]] = {}
+        for channel in world.monitor.channels:
+            if channel.metric != "separation" or channel.reference not in entities:
+                continue
+            groups = []
+            for name in (*channel.subjects, channel.reference):
+                entity = entities.get(name)
+                groups.append([] if entity is None else list(entity.links))
+            first = [link for group in groups[:-1] for link in group]
+            second = groups[-1]
+            a_first = self._of(first, a, robot_of, owner)
+            b_second = self._of(second, b, robot_of, owner)
+            a_second = self._of(second, a, robot_of, owner)
+            b_first = self._of(first, b, robot_of, owner)
+            need = float(channel.limit + channel.soft_threshold)
+            if a_first and b_second:
+                self._checks.append((a_first, b_second, need))
+            elif a_second and b_first:
+                self._checks.append((a_second, b_first, need))
+        #: aligned(x, y, within=d) that a requirement asks of the two arms' reference
+        #: points: (link index in a's model, link index in b's model, d)
+        self._aligned: list[tuple[int, int, float]] = []
+        refs = {}
+        for name, entity in entities.items():
+            link = entity.reference_link
+            for arm in self.arms:
+                if link is not None and link.robot == robot_of[arm] and self._of(
+                        [link], arm, robot_of, owner):
+                    refs[name] = (arm, list(self.kin[arm].link_names).index(link.link))
+        for req in world.monitor.requirements:
+            for p in predicates_in(req.first):
+                if p.name != "aligned" or len(p.args) < 2:
+                    continue
+                x, y = refs.get(p.args[0]), refs.get(p.args[1])
+                if x is None or y is None or x[0] == y[0]:
+                    continue
+                ia, ib = (x[1], y[1]) if x[0] == a else (y[1], x[1])
+                self._aligned.append((ia, ib, float(p.params.get("within", 0.05))))
+        for side, arm in enumerate(self.arms):
+            links = self.kin[arm].arm.articulation.get_links()
+            for i in {i for check in self._checks for i in check[side]}:
+                pieces = [piece for shape in links[i].collision_shapes
+                          if (piece := _piece(shape)) is not None]
+                if pieces:
+                    self._geometry[(arm, i)] = pieces
+
+    @property
+    def watched(self) -> bool:
+        """Whether a separation limit, or a required alignment, watches the two arms."""
+        return bool(self._checks or self._aligned)
+
+    def _moved_links(self, arm: str) -> set[int]:
+        """Indices of the links the arm's own joints move."""
+        kin = self.kin[arm]
+        every = range(len(kin.link_names))
+        home = np.asarray(kin.spec.home, dtype=np.float64)
+        p0, _ = kin.link_poses(home, every)
+        p1, _ = kin.link_poses(home + _PROBE, every)
+        moved = np.linalg.norm(np.asarray(p1) - np.asarray(p0), axis=1) > 1e-6
+        ee = list(kin.link_names).index(kin.spec.ee_link)
+        return {i for i in every if moved[i]} | {ee}
+
+    def _of(self, links, arm: str, robot_of: dict[str, str],
+            owner: dict[str, set[int]]) -> list[int]:
+        """The indices, in ``arm``'s model, of those of ``links`` that ``arm`` carries (its
+        robot's links its joints move, and its static links that no other arm moves)."""
+        names = list(self.kin[arm].link_names)
+        others = set().union(*(owner[o] for o in self.arms if o != arm
+                               and robot_of[o] == robot_of[arm]))
+        out = []
+        for link in links:
+            if link.robot != robot_of[arm] or link.link not in names:
+                continue
+            i = names.index(link.link)
+            if i in owner[arm] or i not in others:
+                out.append(i)
+        return sorted(set(out))
+
+    def _objects(self, arm: str, q: NDArray[np.float64], links: list[int]) -> list:
+        kin = self.kin[arm]
+        ps, quats = kin.link_poses(np.asarray(q, dtype=np.float64), links)
+        out = []
+        for i, p, quat in zip(links, ps, quats, strict=True):
+            link = np.eye(4)
+            link[:3, :3] = quat_to_matrix(np.asarray(quat, dtype=np.float64))
+            link[:3, 3] = p
+            for geometry, local in self._geometry.get((arm, i), ()):
+                m = link @ local
+                out.append(fcl.CollisionObject(geometry, fcl.Transform(
+                    np.ascontiguousarray(m[:3, :3]), np.ascontiguousarray(m[:3, 3]))))
+        return out
+
+    def margin(self, qa: NDArray[np.float64], qb: NDArray[np.float64]) -> float:
+        """Smallest distance less (limit + warning band) over the channels, for arm ``a``
+        at joints ``qa`` and arm ``b`` at ``qb`` (m); +inf with no separation limit."""
+        best = float("inf")
+        for ia, ib, need in self._checks:
+            left, right = self._objects(self.arms[0], qa, ia), self._objects(self.arms[1], qb, ib)
+            for x in left:
+                for y in right:
+                    best = min(best, signed_distance(x, y) - need)
+        return best
+
+    def aligned(self, qa: NDArray[np.float64], qb: NDArray[np.float64],
+                slack: float = 0.005) -> bool:
+        """Whether every ``aligned`` a requirement asks of the two arms holds, ``slack`` (m)
+        to spare, with arm ``a`` at ``qa`` and ``b`` at ``qb``."""
+        for ia, ib, within in self._aligned:
+            pa = np.asarray(self.kin[self.arms[0]].link_poses(qa, [ia])[0][0], dtype=np.float64)
+            pb = np.asarray(self.kin[self.arms[1]].link_poses(qb, [ib])[0][0], dtype=np.float64)
+            if float(np.linalg.norm(pa - pb)) > within - slack:
+                return False
+        return True
+
+    def along(self, qa0: NDArray[np.float64], qa1: NDArray[np.float64],
+              qb0: NDArray[np.float64], qb1: NDArray[np.float64], samples: int = 8) -> float:
+        """The smallest :meth:`margin` along joint-space lines of both arms at once
+        (``qa0`` to ``qa1`` and ``qb0`` to ``qb1``), at ``samples`` + 1 points."""
+        return min(self.margin(qa0 + s * (qa1 - qa0), qb0 + s * (qb1 - qb0))
+                   for s in np.linspace(0.0, 1.0, samples + 1))
+
+
+__all__ = ["ArmGap"]

@@ -1,0 +1,86 @@
+"""Handing a long block over between two arms kept apart by a separation limit: the block
+lies across the arm-to-arm direction (the sampler's layouts), so the giver turns it to
+point at the taker, and each hand holds its own end; on Baxter, whose forearms stand tall
+above hands that point down, the taker's hand leans away from the giver's."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fsvla.experts import rollout
+from fsvla.experts.style import CAREFUL
+from fsvla.experts.world import World
+
+pytestmark = pytest.mark.sim
+
+BAR = """\
+scenario pass_bar
+  suite collaborative
+  task handover(object=block)
+  embodiment {embodiment}
+  instruction "Hand the block from the left arm to the right arm and set it on the plate."
+  horizon 40 s
+
+  object block: block(size=(2.9 cm, 16.6 cm, 2.9 cm), mass=120 g) at ({x}, 15 cm) yaw 90 deg
+  object plate: plate(radius=9 cm) at ({x}, -18 cm)
+
+  constrain arms: separation(left_arm, right_arm) >= 1 cm warn 3 cm
+
+  success on(block, plate) and released(block) for 1 s
+"""
+CASES = [("baxter", "-21 cm"), ("dual_panda", "-22 cm")]
+#: the runner's layout seed for its seed 0
+SEED = 1731914883
+
+
+def _write(tmp_path: Path, embodiment: str, x: str) -> Path:
+    path = tmp_path / "scenario.fsv"
+    path.write_text(BAR.format(embodiment=embodiment, x=x), encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize(("embodiment", "x"), CASES)
+def test_exchange_keeps_the_arms_apart(tmp_path: Path, embodiment: str, x: str) -> None:
+    """The planned exchange: the hands on the two sides of the block's middle along the
+    arm-to-arm direction, and the arms' links, on their models, out of the separation
+    limit's warning band while the taker comes in."""
+    from fsvla.env import make
+    from fsvla.experts.skills import branch_for_path, horizontal, top_down_grasp
+    from fsvla.experts.tasks import handover as H
+    from fsvla.experts.tasks.arm_gap import ArmGap
+
+    env = make(str(_write(tmp_path, embodiment, x)), "L0", SEED)
+    env.reset()
+    world = World.of_env(env)
+    e, meet = H._plan_exchange(world, CAREFUL, "block", "left", "right")
+    bar = H._Bar.of(world, "block")
+    toward = horizontal(world.base_position("right") - world.base_position("left"))
+    grip = top_down_grasp(world, "left", bar.centre + e * (bar.half[0] - meet.inset) * bar.along
+                          + np.array([0.0, 0.0, 0.3 * bar.half[2]]), bar.across,
+                          2 * float(bar.half[1])).pose
+    held = H._giver_at_meeting(world, "left", grip, bar.centre, toward, meet.middle)
+    take = H._taker_grasp(world, "right", bar, meet.middle, toward, meet.take_at, meet.tilt)
+    assert (held.p - meet.middle) @ toward < -0.04
+    assert (take.pose.p - meet.middle) @ toward > 0.04
+    q_giver = branch_for_path(world, "left", (held,))
+    assert q_giver is not None
+    gap = ArmGap(world, "left", "right")
+    assert gap.watched
+    assert H._exchange_margin(world, gap, "left", "right", q_giver, take, meet.above) >= H.GAP_SLACK
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("embodiment", "x"), CASES)
+def test_handover_of_a_bar_across_the_arms(tmp_path: Path, embodiment: str, x: str) -> None:
+    """The careful expert hands the bar over and sets it down without crossing the
+    separation limit; the careless one, taking the bar at its middle beside the giver's
+    hand, crosses it."""
+    path = str(_write(tmp_path, embodiment, x))
+    careful = rollout(path, "careful", "L0", SEED)
+    assert careful.success and not careful.violation, (careful.violated, careful.segments[-5:])
+    careless = rollout(path, "careless", "L0", SEED)
+    assert "arms" in careless.violated, careless.violated
