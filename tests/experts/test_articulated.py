@@ -55,9 +55,10 @@ def test_a_part_already_shut_is_left_alone(tmp_path: Path) -> None:
 
 
 def test_closing_a_standing_lid_is_a_clear_error(tmp_path: Path) -> None:
+    # a knob wider than the hand opens (0.3 × 30 cm): it cannot be pinched by its ends
     text = DRAWER.format(embodiment="panda", open=0.9, at="(15 cm, 5 cm)").replace(
         "drawer_cabinet(size=(22 cm, 20 cm, 14 cm), travel=11 cm, open=0.9)",
-        "lidded_box(size=(18 cm, 14 cm, 12 cm), open=0.9)")
+        "lidded_box(size=(18 cm, 30 cm, 12 cm), open=0.9)")
     from fsvla.env import make
 
     env = make(str(_write(tmp_path, text)), "L0", 0)
@@ -66,4 +67,84 @@ def test_closing_a_standing_lid_is_a_clear_error(tmp_path: Path) -> None:
     expert.reset(None)
     with pytest.raises(NotImplementedError, match="cannot yet close `cabinet`'s revolute `lid`"):
         expert.act(observation)
+    env.close()
+
+
+LID = """\
+scenario close_lid
+  suite force
+  task {task}(object=box)
+  embodiment {embodiment}
+  instruction "{task} the box."
+  horizon 20 s
+
+  object box: lidded_box(size=(18 cm, 14 cm, 9 cm){open}) at {at}
+
+  constrain grip: contact_force(gripper) <= 50 N warn 12 N
+
+  success {success} for 1 s
+"""
+
+
+@pytest.mark.slow
+def test_careful_expert_lowers_a_standing_lid_shut(tmp_path: Path) -> None:
+    """A lid standing open past upright is pinched by its knob, pulled over and lowered
+    onto its seat (it was a NotImplementedError)."""
+    path = _write(tmp_path, LID.format(task="close", embodiment="dual_panda", open=", open=0.9",
+                                       at="(-14 cm, 9 cm)", success="closed(box)"))
+    result = rollout(str(path), "careful", "L0", 0)
+    assert result.safe_success, result.summary()
+    assert "swing lid" in result.segments
+
+
+@pytest.mark.slow
+def test_careful_expert_opens_a_low_lid(tmp_path: Path) -> None:
+    """A lid 9 cm above the table: the upright hand under the knob meets the table; the
+    knob pinched by its ends lifts it past upright."""
+    path = _write(tmp_path, LID.format(task="open", embodiment="panda", open="",
+                                       at="(5 cm, 10 cm)", success="opened(box, fraction=0.6)"))
+    result = rollout(str(path), "careful", "L0", 0)
+    assert result.safe_success, result.summary()
+
+
+DOOR = """\
+scenario close_door
+  suite force
+  task close(object=oven)
+  embodiment baxter
+  instruction "Close the microwave."
+  horizon 20 s
+
+  object oven: microwave(size=(39 cm, 34 cm, 25 cm), open=0.9) at (21 cm, 4 cm)
+
+  constrain grip: contact_force(gripper) <= 50 N warn 12 N
+
+  success closed(oven) for 1 s
+"""
+
+
+@pytest.mark.slow
+def test_careful_expert_swings_a_door_shut(tmp_path: Path) -> None:
+    """A microwave's door standing open is pinched by its handle and turned shut about its
+    hinge (it was a NotImplementedError)."""
+    result = rollout(str(_write(tmp_path, DOOR)), "careful", "L0", 0)
+    assert result.safe_success, result.summary()
+    assert "swing door" in result.segments
+
+
+def test_the_careful_push_of_a_drawer_is_force_guarded(tmp_path: Path) -> None:
+    """The push that shuts a drawer stops on a force rise below the limit (half of it, out
+    of its warning band): a drawer meeting its stop does not spike the force."""
+    from fsvla.env import make
+    from fsvla.experts.style import CAREFUL, CARELESS
+    from fsvla.experts.tasks.open_close import push_part_closed
+
+    path = _write(tmp_path, DRAWER.format(embodiment="panda", open=0.8, at="(12 cm, 0.3 cm)"))
+    env = make(str(path), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    pushes = [s for s in push_part_closed(world, CAREFUL, "cabinet") if s.label == "push part"]
+    assert pushes and all(s.guard is not None and s.guard.force <= 25.0 for s in pushes)
+    careless = [s for s in push_part_closed(world, CARELESS, "cabinet") if s.label == "push part"]
+    assert careless and all(s.guard is None for s in careless)
     env.close()

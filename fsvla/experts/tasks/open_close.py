@@ -5,12 +5,14 @@ from __future__ import annotations
 import numpy as np
 
 from fsvla.compiler.pose import axis_angle_matrix
+from fsvla.dsl.models import predicates_in
 
-from ..motion import ArmDriver, Pose, Segment
+from ..motion import ArmDriver, Guard, Pose, Segment
 from ..skills import DOWN, UP, Plan, free_speed, nearest_arm, opening_for, transit
 from ..style import Style
 from ..world import World
 from .common import HAND_HALF_WIDTH, HANDLE_DEPTH, required_fraction
+from .hinge import has_shape, knob_pinch_fits, swing_door, swing_lid
 from .lid import LID_PAST_VERTICAL, lift_lid
 
 
@@ -53,20 +55,38 @@ def push_part_closed(world: World, style: Style, body: str) -> Plan:
                   label="touch part")
     push = world.open_fraction(body) * travel - 0.002  # stop at the end of travel
     goal = touch.moved(-push * opening)
+    # careful: a move-until-contact, so that a drawer meeting its stop (or a hand meeting
+    # the carcass) does not spike the force: the push itself needs a few newtons
+    guard = Guard(arm, push_force(world, arm, body), body) if style.avoid_hazards else None
     # slowly: a rigid hand on a free-sliding drawer chatters, ~60 N spikes at 6 cm/s
     yield Segment({arm: goal}, speed=2 * style.contact_speed, settle=style.settle,
-                  label="push part")
+                  label="push part", guard=guard)
     for _ in range(3):  # the wrist, thicker than the hand, may meet the front first
         left = world.open_fraction(body) * travel
         if left < 0.02 * travel:
             break
-        goal = goal.moved(-(left - 0.002) * opening)
+        goal = world.current_pose(arm).moved(-(left - 0.002) * opening)
         yield Segment({arm: goal}, speed=2 * style.contact_speed, settle=style.settle,
-                      label="push part")
+                      label="push part", guard=guard)
     back = world.current_pose(arm)
     yield Segment({arm: back.moved(0.04 * opening)}, speed=free_speed(style), label="back")
     yield Segment({arm: back.moved(0.04 * opening + 0.1 * UP)}, speed=free_speed(style),
                   label="up")
+
+
+#: The force (N) a careful push stops at where no contact-force limit watches it.
+PUSH_FORCE = 25.0
+
+
+def push_force(world: World, arm: str, body: str) -> float:
+    """What a careful push of ``body`` stops at: PUSH_FORCE, or half of the tightest
+    contact-force limit on the hand or the body and out of its warning band, at least 3 N."""
+    hand = {"gripper", f"{arm}_gripper", body}
+    force = PUSH_FORCE
+    for channel in world.monitor.channels:
+        if channel.metric == "contact_force" and set(channel.subjects) & hand:
+            force = min(force, 0.5 * channel.limit, channel.limit - channel.soft_threshold - 1.0)
+    return max(3.0, force)
 
 
 def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Plan:
@@ -127,32 +147,50 @@ def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
 SHUT = 0.02
 
 
+#: A part is swung shut to this fraction of its range (then let go): a lid lowered onto
+#: its seat would be pressed into it by the hand.
+SWUNG_SHUT = 0.01
+
+
 def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
-    """A drawer: pull its handle; a lid: lift it by its knob past upright (where it stays
-    open) or as far as a requirement asks; a hinged door: not yet."""
+    """A drawer: pull its handle; a lid: pinch its knob by its ends and lift it past upright
+    (where it stays open) or as far as a requirement asks; a hinged door: pinch its handle
+    and swing it open past the fraction asked."""
     body = roles["object"]
     part, joint = world.part(body)
     need = required_fraction(world, body)
+    span = joint.upper - joint.lower
     if _sliding(world, body):
         yield from plan_move_part(world, style, body, max(0.8, need + 0.15))
     elif _knob_lid(world, body):
-        span = joint.upper - joint.lower
-        yield from lift_lid(world, style, body, min(max(LID_PAST_VERTICAL, (need + 0.07) * span),
-                                                    0.95 * span))
+        angle = min(max(LID_PAST_VERTICAL, (need + 0.07) * span), 0.95 * span)
+        if knob_pinch_fits(world, body):
+            yield from swing_lid(world, style, body, angle)
+        else:
+            yield from lift_lid(world, style, body, angle)
+    elif _handled_door(world, body):
+        asked = max(need, _success_fraction(world, body))
+        yield from swing_door(world, style, body, min(asked + 0.12, 0.95) * span)
     else:
         raise NotImplementedError(_unsupported(body, part.name, joint.type, "open"))
 
 
 def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
-    """A drawer: push its front shut; a part already shut is left alone; a lid or a hinged
-    door standing open: not yet."""
+    """A drawer: push its front shut; a part already shut is left alone; a lid standing
+    open: pinch its knob, pull it over upright and lower it onto its seat; a hinged door:
+    pinch its handle and swing it shut."""
     body = roles["object"]
     part, joint = world.part(body)
+    span = joint.upper - joint.lower
     if world.open_fraction(body) < SHUT:
         yield Segment(settle=20, label="already shut")
     elif _sliding(world, body):
         yield from push_part_closed(world, style, body)
-    else:  # a lid standing open is pushed over its hinge: not yet
+    elif _knob_lid(world, body) and knob_pinch_fits(world, body):
+        yield from swing_lid(world, style, body, SWUNG_SHUT * span)
+    elif _handled_door(world, body):
+        yield from swing_door(world, style, body, SWUNG_SHUT * span)
+    else:
         raise NotImplementedError(_unsupported(body, part.name, joint.type, "close"))
 
 
@@ -169,14 +207,26 @@ def _knob_lid(world: World, body: str) -> bool:
             and _has_shape(world, body, part.link, "panel"))
 
 
-def _has_shape(world: World, body: str, link: str, shape: str) -> bool:
-    return any(lk.name == link and any(s.name == shape for s in lk.collision)
-               for lk in world.asset(body).links)
+def _handled_door(world: World, body: str) -> bool:
+    """A revolute part with a `handle` and a `panel` (a door on a hinge)."""
+    part, joint = world.part(body)
+    return (joint.type == "revolute" and _has_shape(world, body, part.link, "handle")
+            and _has_shape(world, body, part.link, "panel"))
+
+
+_has_shape = has_shape
+
+
+def _success_fraction(world: World, body: str) -> float:
+    """The largest ``opened(body, fraction=f)`` the success condition asks for (0: none)."""
+    return max([0.0, *(float(p.params.get("fraction", 0.5))
+                       for p in predicates_in(world.monitor.success.condition)
+                       if p.name == "opened" and p.args[0] == body)])
 
 
 def _unsupported(body: str, part: str, joint: str, verb: str) -> str:
     return (f"the experts cannot yet {verb} `{body}`'s {joint} `{part}`: they open and "
-            f"close drawers by a `handle` and open lids by a `knob`")
+            f"close drawers and doors by a `handle` and lids by a `knob`")
 
 
 __all__ = ["SHUT", "part_handle", "plan_close", "plan_move_part", "plan_open", "push_part_closed"]
