@@ -8,6 +8,7 @@ from .. import grasps
 from ..skills import DOWN, UP, Plan, held_offset, nearest_arm, pick, place
 from ..style import Style
 from ..world import World
+from .cavity import place_in_cavity
 from .common import HAND_BOTTOM, HAND_HALF_LENGTH, required_fraction, retreat_home
 from .lid import LID_PAST_VERTICAL, lift_lid
 from .open_close import part_handle, plan_move_part
@@ -105,14 +106,19 @@ def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
 
 
 def _insert_into_cavity(world: World, style: Style, obj: str, target: str) -> Plan:
-    """An open container: pick the object and set it down on the floor of the container's
-    cavity (``inside`` tests the cavity), not on its rim."""
+    """An open container: pick the object and put it in the container's cavity (``inside``
+    tests the cavity). Careful: let go as low as the hand stays clear of the container
+    (:func:`~.cavity.place_in_cavity`: a Panda hand is wider than a pot's mouth); careless:
+    set down on the cavity's floor, the hand landing on the rim where it is too wide."""
     arm = nearest_arm(world, world.body_pose(obj).p)
     yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
-    cavity = world.asset(target).cavity
-    centre = world.to_world(target, cavity.pose.position)
-    floor = float(centre[2]) - float(getattr(cavity, "half_length", 0.0))
-    yield from place(world, style, arm, obj, np.array([centre[0], centre[1], floor]))
+    if style.avoid_hazards:  # the hand stays clear of the rim; the object drops the rest
+        yield from place_in_cavity(world, style, arm, obj, target)
+    else:  # careless: onto the floor, the hand down into the mouth whatever it meets
+        cavity = world.asset(target).cavity
+        centre = world.to_world(target, cavity.pose.position)
+        floor = float(centre[2]) - float(getattr(cavity, "half_length", 0.0))
+        yield from place(world, style, arm, obj, np.array([centre[0], centre[1], floor]))
     yield from retreat_home(world, style, arm)
 
 

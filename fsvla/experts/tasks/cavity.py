@@ -1,0 +1,260 @@
+"""Setting a held object into an open container (a pot, a bowl) without the hand touching
+it: a Panda hand is 21 cm long across its fingers, wider than a 19 cm pot's mouth, and
+coming down to put the object on the floor it lands on the rim (a -300 N knock on the
+gripper). The careful hand comes down only until some piece of the hand, or of the
+held object, would come within a margin of a piece of the container beneath it; the
+object is let go there, over the floor of the cavity, and drops the rest of the way.
+
+The lowest height is found from the geometry, not by feeling for the rim: the hand's
+and the held object's boxes are sampled at about 1 cm and each sample is moved straight
+down onto the container's collision pieces (its wall pieces and its base). Among the
+points the object's centre may be set over (inside the cavity, which is where the
+``inside`` predicate looks for it) and a few turns of the hand about the vertical, the
+one that lets the object go lowest is taken, and the descent is guarded: a touch of the
+container stops it."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from itertools import product
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fsvla.compiler.pose import quat_to_matrix
+
+from ..motion import Guard, Pose, Segment
+from ..skills import (
+    CARRY_SPEED,
+    LIGHT_LOAD,
+    UP,
+    Plan,
+    branch_for_path,
+    force_watched,
+    free_speed,
+    gentle,
+    load_reach,
+    transit,
+)
+from ..style import Style
+from ..world import World, box_distance
+
+#: How far (m) any piece of the hand (the fingers also as they open to let go) stays above
+#: the container's pieces beneath it, and how far beside them a piece counts as beneath.
+HAND_CLEAR = 0.01
+HAND_BESIDE = 0.005
+#: How far (m) beside the container's pieces a piece of the held object counts as above
+#: them. It is let go the style's release height above them, or, watched for force (a
+#: fragile object), set down on them (a 3 mm drop of a 60 g cube lands with 15 N).
+OBJECT_BESIDE = 0.004
+#: Spacing (m) of the sample points on the hand's and the object's boxes.
+SAMPLE = 0.01
+#: Links of the arm within this distance (m) of the tool centre point count as the hand
+#: (a Baxter's gripper base and wrist stand 10-15 cm above its fingertips).
+HAND_RADIUS = 0.2
+#: How far (m) from the cavity's wall the object's centre stays.
+CENTRE_MARGIN = 0.01
+#: The hand's turns about the vertical that are tried (rad), nearest to the grasp first.
+TURNS = (0.0, np.pi / 6, -np.pi / 6, np.pi / 3, -np.pi / 3, np.pi / 2)
+#: How far (m) each finger opens away from the object to let it go (a wide-open hand in
+#: a narrow mouth would open onto the wall).
+RELEASE_GAP = 0.008
+#: How near (m) the TCP an object's box must be for the hand to hold it.
+HELD_WITHIN = 0.02
+#: Force (N) at which a touch of the container stops the descent, at most.
+TOUCH_FORCE = 5.0
+
+
+def _box_surface(lo: NDArray[np.float64], hi: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Points on the surface of the box [lo, hi], about SAMPLE apart."""
+    axes = [np.linspace(a, b, max(2, int(np.ceil((b - a) / SAMPLE)) + 1)) for a, b in zip(lo, hi)]
+    grid = np.array(list(product(*axes)))
+    on = np.any(np.isclose(grid, lo) | np.isclose(grid, hi), axis=1)
+    return grid[on]
+
+
+def hand_points(world: World, arm: str, gap: float = 0.0) -> NDArray[np.float64]:
+    """Sample points (TCP frame, m) on the boxes of the arm's links near the TCP, as the
+    hand is now, and the fingers' also where they are once each has opened ``gap`` (m)
+    farther out along the closing axis (to let go)."""
+    kin = world.kinematics(arm)
+    tcp = world.current_pose(arm)
+    closing = world.finger_axis(arm)
+    fingers = world.arm_spec(arm).gripper.finger_links
+    points = []
+    for index, link in enumerate(kin.link_names):
+        vertices = kin.link_vertices(index)
+        if vertices is None:
+            continue
+        try:
+            pose = world.state.robot_link_pose(arm, link)
+        except StopIteration:
+            continue
+        local = (vertices @ quat_to_matrix(pose.q).T + np.asarray(pose.p) - tcp.p) @ tcp.R
+        if float(np.min(np.linalg.norm(local, axis=1))) > HAND_RADIUS:
+            continue
+        box = _box_surface(local.min(axis=0), local.max(axis=0))
+        points.append(box)
+        if gap > 0.0 and link.startswith(tuple(fingers)):  # a finger (or its tip) opening
+            side = 1.0 if float(np.mean(local, axis=0) @ closing) >= 0.0 else -1.0
+            points.append(box + side * gap * closing)
+    return np.concatenate(points) if points else np.zeros((0, 3))
+
+
+def object_points(world: World, arm: str, obj: str) -> NDArray[np.float64]:
+    """Sample points (TCP frame, m) on the held object's box, as it hangs in the hand now."""
+    b = world.asset(obj).bounds
+    centre, half = np.asarray(b.center), np.asarray(b.half_extents)
+    pose = world.body_pose(obj)
+    tcp = world.current_pose(arm)
+    local = _box_surface(centre - half, centre + half)
+    return (local @ pose.R.T + pose.p - tcp.p) @ tcp.R
+
+
+def _pieces(world: World, body: str) -> list[tuple[NDArray, NDArray, NDArray]]:
+    """The body's collision pieces as boxes in the world: (centre, rotation, half sizes);
+    a cylinder as the box around it."""
+    root = world.body_pose(body)
+    asset = world.asset(body)
+    shapes = getattr(asset, "collision", None) or [s for link in asset.links for s in link.collision]
+    pieces = []
+    for shape in shapes:
+        if getattr(shape, "half_size", None) is not None:
+            half = np.asarray(shape.half_size, dtype=np.float64)
+        elif getattr(shape, "radius", None) is not None and getattr(shape, "half_length", None) is not None:
+            half = np.array([shape.radius, shape.radius, shape.half_length], dtype=np.float64)
+        else:
+            continue
+        R = root.R @ quat_to_matrix(shape.pose.quaternion)
+        pieces.append((root.R @ np.asarray(shape.pose.position) + root.p, R, half))
+    return pieces
+
+
+def _lowest(points: NDArray[np.float64], pieces, beside: float, clear: float) -> float:
+    """The lowest height (m) to which world ``points`` (n × 3, their heights given as
+    offsets from 0) can be moved straight down without coming within ``clear`` above, or
+    ``beside`` beside, a piece: the largest over the points and the pieces beneath them
+    of the piece's top there plus ``clear`` less the point's offset; -inf if none is."""
+    best = -np.inf
+    for c, R, half in pieces:
+        d = R[2, :]  # the vertical, in the piece's frame
+        h = half + beside * (np.abs(d) < 0.7)  # grown sideways, not upward
+        a = (np.column_stack([points[:, 0], points[:, 1], np.zeros(len(points))]) - c) @ R
+        lo = np.full(len(points), -np.inf)
+        hi = np.full(len(points), np.inf)
+        for i in range(3):
+            if abs(d[i]) < 1e-9:
+                out = np.abs(a[:, i]) > h[i]
+                lo[out], hi[out] = np.inf, -np.inf
+                continue
+            t0, t1 = (-h[i] - a[:, i]) / d[i], (h[i] - a[:, i]) / d[i]
+            lo = np.maximum(lo, np.minimum(t0, t1))
+            hi = np.minimum(hi, np.maximum(t0, t1))
+        hit = lo <= hi
+        if np.any(hit):
+            best = max(best, float(np.max(hi[hit] + clear - points[hit, 2])))
+    return best
+
+
+def _turn(angle: float) -> NDArray[np.float64]:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _cavity(world: World, target: str) -> tuple[NDArray[np.float64], float, float]:
+    """The cavity's axis point at its floor (world), its radius and its floor height."""
+    cavity = world.asset(target).cavity
+    root = world.body_pose(target)
+    centre = root.R @ np.asarray(cavity.pose.position) + root.p
+    axis = root.R @ quat_to_matrix(cavity.pose.quaternion)[:, 2]
+    floor = centre - float(cavity.half_length) * axis
+    return floor, float(cavity.radius), float(floor[2])
+
+
+def release_pose(world: World, arm: str, obj: str, target: str, clear: float = 0.0,
+                 turns: tuple[float, ...] = TURNS) -> list[tuple[float, Pose]]:
+    """Where the hand holding ``obj`` as it does now lets it go over ``target``'s cavity:
+    (how far the object drops, TCP pose), best first, over the object's centre set on a
+    few rings inside the cavity and the hand's ``turns`` about the vertical; ``clear``:
+    how far (m) above what is beneath it the object would be let go at best."""
+    tcp = world.current_pose(arm)
+    hand = hand_points(world, arm, RELEASE_GAP)
+    held = object_points(world, arm, obj)
+    lo, hi = world.bounds(obj)
+    centre_off = 0.5 * (lo + hi) - tcp.p  # the object's centre from the TCP, in the world
+    floor, radius, floor_z = _cavity(world, target)
+    pieces = _pieces(world, target)
+    reach = max(0.0, radius - CENTRE_MARGIN)
+    spots = [np.zeros(2)] + [r * np.array([np.cos(a), np.sin(a)])
+                             for r in (0.5 * reach, reach) if r > 0.003
+                             for a in np.linspace(0.0, 2 * np.pi, 8, endpoint=False)]
+    options = []
+    for k, angle in enumerate(turns):
+        turn = _turn(angle)
+        R = turn @ tcp.R
+        off = turn @ centre_off
+        h, o = hand @ R.T, held @ R.T
+        for spot in spots:
+            xy = floor[:2] + spot - off[:2]
+            z = max(_lowest(h + np.array([xy[0], xy[1], 0.0]), pieces, HAND_BESIDE, HAND_CLEAR),
+                    _lowest(o + np.array([xy[0], xy[1], 0.0]), pieces, OBJECT_BESIDE, clear),
+                    floor_z + clear - float(np.min(o[:, 2])))
+            drop = z + float(np.min(o[:, 2])) - floor_z
+            # ties: the hand turned least, the object nearest the cavity's axis
+            score = drop + 0.002 * k + 0.01 * float(np.linalg.norm(spot))
+            options.append((score, drop, Pose(np.array([xy[0], xy[1], z]), R)))
+    options.sort(key=lambda option: option[0])
+    return [(drop, pose) for _score, drop, pose in options]
+
+
+def _holds(world: World, arm: str, obj: str) -> bool:
+    """Whether ``obj`` is between the fingers: its box within 2 cm of the TCP."""
+    lo, hi = world.bounds(obj)
+    return box_distance(world.current_pose(arm).p, lo, hi) <= HELD_WITHIN
+
+
+def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
+                    retreat: float = 0.1) -> Plan:
+    """Carry the held ``obj`` over ``target``'s cavity, come down (guarded) to the lowest
+    pose the hand stays clear of the container at (:func:`release_pose`), open the fingers
+    a little, and back off straight up. Nothing when the hand does not hold ``obj`` (a
+    grasp that missed: the release pose of an object on the table is meaningless)."""
+    if not _holds(world, arm, obj):
+        return
+    fragile = force_watched(world, obj)
+    clear = 0.0 if fragile else style.release_height
+    options = release_pose(world, arm, obj, target, clear)
+    goal = options[0][1]
+    for drop, pose in options[:8]:  # the first whose descent the arm follows comfortably
+        if branch_for_path(world, arm, (pose.moved(0.08 * UP), pose)) is not None:
+            goal = pose
+            break
+    tcp = world.current_pose(arm)
+    below = float(tcp.p[2] - world.bounds(obj)[0][2]) + 0.03
+    heavy = float(world.asset(obj).mass) > LIGHT_LOAD
+    carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
+        if heavy else style
+    yield from transit(world, carrying, arm, goal.moved(0.08 * UP), below=below, exclude=(obj,),
+                       around=load_reach(world, arm, obj))
+    if not _holds(world, arm, obj):  # dropped on the way: nothing left to place
+        return
+    # the object may have turned in the fingers on the way: the height again, as it hangs now
+    again = release_pose(world, arm, obj, target, clear, turns=(0.0,))
+    near = min(again, key=lambda option: float(np.linalg.norm(option[1].p[:2] - goal.p[:2])))
+    goal = Pose(np.array([goal.p[0], goal.p[1], max(goal.p[2], near[1].p[2])]), goal.R)
+    limit = world.force_limit("gripper", obj, *[f"{a}_gripper" for a in world.arm_names])
+    touch = TOUCH_FORCE if limit is None else min(TOUCH_FORCE, 0.25 * limit)
+    guard = Guard(arm, touch, target)
+    yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, guard=guard,
+                  label="lower")
+    yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
+                  guard=guard, label="touch")
+    opening = min(1.0, world.gripper_opening(arm) + 2 * RELEASE_GAP / world.max_width(arm))
+    yield Segment(grippers={arm: opening},
+                  gripper_steps=style.gripper_steps * (2 if fragile else 1),
+                  settle=style.settle, label="release")
+    yield Segment({arm: world.current_pose(arm).moved(retreat * UP)}, speed=free_speed(style),
+                  label="retreat")
+
+
+__all__ = ["hand_points", "object_points", "place_in_cavity", "release_pose"]
