@@ -164,11 +164,12 @@ def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     # down past the knob's ends, with nothing of the lid in their way
     beyond = 0.06 * (axis_angle_matrix(h.axis, h.now) @ h.closed @ outward)
     if style.avoid_hazards:
-        for candidate, point in options:
-            arc = path(candidate, point)
-            if branch_for_path(world, arm, (arc[0].moved(beyond), *arc)) is not None:
-                R, local = candidate, point
-                break
+        found = next(((candidate, point) for candidate, point in options
+                      if branch_for_path(world, arm, (path(candidate, point)[0].moved(beyond),
+                                                      *path(candidate, point))) is not None), None)
+        if found is None:
+            raise NotImplementedError(_out_of_reach(arm, body, "knob", h.now, angle))
+        R, local = found
     start = _lid_pose(h, R, local, centre, h.now)
     arc = path(R, local)
     back = start.moved(beyond)
@@ -275,6 +276,8 @@ def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
             if branch_for_path(world, arm, (back, *arc)) is not None:
                 R = candidate
                 break
+        else:
+            raise NotImplementedError(_out_of_reach(arm, body, "handle", h.now, angle))
     at = pose_at(R)
     start = at(h.now)
     approach = R @ world.approach_axis(arm)
@@ -327,6 +330,14 @@ def pinch(world: World, style: Style, arm: str, body: str, width: float) -> Plan
         goal = max(0.0, goal - 2 * SLOW_CLOSE)
         yield Segment(grippers={arm: goal}, gripper_steps=2, settle=2, guard=guard,
                       label="squeeze")
+
+
+def _out_of_reach(arm: str, body: str, held: str, start: float, end: float) -> str:
+    """Why the careful expert does not swing a part: no IK branch follows the arc (an arm
+    driven along it anyway leaves the arc and flails through the scene)."""
+    return (f"the careful expert cannot swing `{body}` by its {held} from "
+            f"{np.degrees(start):.0f}° to {np.degrees(end):.0f}°: no IK branch of `{arm}` "
+            f"follows the {held}'s arc within the joint limits (out of the arm's reach)")
 
 
 def _sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose],
