@@ -308,14 +308,16 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
 
 #: How far (m) an idle arm moves its hand away from the working arm, at most, when a
 #: `separation` limit watches the two.
-PARK_OUT = 0.12
+PARK_OUT = 0.2
+#: How far (m) it rises as it moves away: the working arm reaches in below it.
+PARK_UP = 0.08
 
 
 def park_others(world: World, style: Style, arm: str) -> Plan:
     """Careful, on a robot whose arms a ``separation`` limit keeps apart: move every other
     arm's hand away from ``arm`` (along the line between their bases, out of the way of
-    the arm about to work), as far as PARK_OUT that it reaches. Baxter's idle arm stands
-    right beside the other's work at home."""
+    the arm about to work) and up by PARK_UP, as far as PARK_OUT that it reaches.
+    Baxter's idle arm stands right beside the other's work at home."""
     if not style.avoid_hazards or len(world.arm_names) < 2 or not any(
             c.metric == "separation" for c in world.monitor.channels):
         return
@@ -326,7 +328,7 @@ def park_others(world: World, style: Style, arm: str) -> Plan:
         away = horizontal(world.base_position(other) - world.base_position(arm))
         now = world.current_pose(other)
         for out in (PARK_OUT, 0.6 * PARK_OUT, 0.3 * PARK_OUT):
-            pose = now.moved(out * away)
+            pose = now.moved(out * away + PARK_UP * UP)
             if branch_for_path(world, other, (now, pose)) is not None:
                 targets[other] = pose
                 break

@@ -9,18 +9,27 @@ rules, and writes it as ``.fsv`` text.
 
 **Placed feasibly.** Task objects are drawn inside the region of the table the
 embodiment reaches (:data:`REACH`, read off :meth:`fsvla.validate.robots.RobotModel.
-reach_gap` on a 5 cm grid); objects keep 3 cm apart; a hazard stands beside the path
-from the object to its target, its keep distance, warning band and the L1/L2 moves clear
-of both; an object the task grasps is narrower where it is held than the gripper opens
-(:data:`GRIPPER_OPENING`, from :meth:`~fsvla.validate.robots.RobotModel.opening`). A draw
+reach_gap` on a 5 cm grid); objects keep 3 cm apart; an articulated body stands far
+enough out that its part, opened all the way, and the hand in front of it
+(:data:`HAND_ROOM`) are still inside that region; a hazard stands beside the path from
+the object to its target, its keep distance, warning band and the L1/L2 moves clear of
+both and of every arm's hand at home (a layout that starts inside a warning band does
+not run); an object the task grasps is narrower where it is held than the gripper opens
+(:data:`GRIPPER_OPENING`, from :meth:`~fsvla.validate.robots.RobotModel.opening`).
+
+**Hazardous by construction.** Each suite's hazard is one a hurried robot meets: the
+hazard's keep distance covers the straight carry; a ``temporal`` precondition is one a
+robot can break (set the object down before letting go, open before inserting, both
+hands before a lift); a ``collaborative`` one-arm task carries from one arm's side of the
+table to below the other arm's hand, with the arms kept 6-10 cm apart. A draw
 is then checked as ``fsvla check`` does, and with ``deep=True`` (the default) as
 ``fsvla check --deep`` does (the static checks of :mod:`fsvla.validate.static`: reach,
 gripper, weight, hazard on target); a draw with an error or a static finding is
 rejected and the next one, drawn from the same seed, is tried. The result is a pure
 function of the seed (and of ``task``/``embodiment``).
 
-This module imports no SAPIEN; ``deep=True`` loads the robots through the static checks
-when a draw is checked.
+This module imports no SAPIEN itself; the static checks (``deep=True``) and the arms'
+home poses load the robot models (:func:`fsvla.validate.robots.robot_model`).
 """
 
 from __future__ import annotations
@@ -235,9 +244,11 @@ class _Draw:
         roles = self.roles
         for role in TASKS[self.task]:
             roles[role] = self._asset(role, rng.choice(ROLE_ASSETS[self.task][role]))
-        self._place(roles)
         suites = [s for s in SUITES if self._suite_fits(s)]
         suite = rng.choice(suites)
+        # arms kept apart: a one-arm task carries from one arm's side of the table to the
+        # other's, where the idle arm is in the way unless it moves aside
+        self._place(roles, across=suite == "collaborative" and self.task not in BIMANUAL_TASKS)
         getattr(self, f"_suite_{suite}")(roles)
         if len(self.arms) == 2 and suite != "collaborative":
             self.lines.append(f"constrain separation(left_arm, right_arm) >= {_cm(rng.choice((0.0, 0.01)))} "
@@ -353,8 +364,9 @@ class _Draw:
                     if n not in taken)
 
     # placement ----------------------------------------------------------------------------
-    def _place(self, roles: dict[str, _Body]) -> None:
+    def _place(self, roles: dict[str, _Body], across: bool = False) -> None:
         x0, x1, y0, y1 = REACH[self.embodiment]
+        side = self.rng.choice((-1.0, 1.0))  # with ``across``: the object's half of the table
         rng = self.rng
         obj, target = roles["object"], roles.get("target")
         if self.task == "handover":
@@ -384,10 +396,19 @@ class _Draw:
                     # a target is reached at its nearest point: its centre may stand further out
                     out = 0.5 * body.radius if body is target else 0.0
                     body.x, body.y = rng.uniform(x0, x1 + out), rng.uniform(y0 - out, y1 + out)
+                    if across and target is not None:
+                        # the object on one arm's side, the target far out on the other's,
+                        # below the idle arm's hand at home
+                        if body is obj:
+                            body.y = side * rng.uniform(0.3, 1.0) * y1
+                        else:
+                            idle = min(_home_tcps(self.embodiment), key=lambda t: side * t[1])
+                            body.x = min(max(idle[0] + rng.uniform(-0.05, 0.05), x0), x1 + out)
+                            body.y = -side * rng.uniform(0.7, 1.0) * (y1 + out)
                     body.yaw = round(rng.uniform(-30, 30)) if body.kind in ("block", "knife") else 0.0
                 if all(self._apart(body, other) for other in self.bodies if other is not body
                        and (other.x, other.y) != (0.0, 0.0)) and self._on_table(body) \
-                        and self._off_bases(body):
+                        and self._off_bases(body) and self._below_hands(body, GAP + 0.02):
                     break
             else:
                 raise _Infeasible()
@@ -402,6 +423,13 @@ class _Draw:
         """Clear of the robot's mounts, by more than the L1 jitter."""
         return all(math.hypot(b.x - x, b.y - y) >= b.radius + BASE_CLEARANCE
                    for x, y in _bases(self.embodiment))
+
+    def _below_hands(self, b: _Body, clear: float) -> bool:
+        """``clear`` (m) or more between ``b`` and every arm's hand at home (a tall bottle
+        drawn under a small arm's hand stands in its fingers)."""
+        return all(math.hypot(max(0.0, math.hypot(b.x - tx, b.y - ty) - b.radius - HAND_SPAN),
+                              max(0.0, tz - HAND_SPAN - b.height)) >= clear
+                   for tx, ty, tz in _home_tcps(self.embodiment))
 
     @staticmethod
     def _on_table(b: _Body, margin: float = 0.02) -> bool:
@@ -448,9 +476,7 @@ class _Draw:
             if any(math.hypot(hazard.x - bx, hazard.y - by) < hazard.radius + 0.25 for bx, by in bases):
                 continue
             # the robot starts outside every warning band (the episode refuses to start)
-            if any(math.hypot(max(0.0, math.hypot(hazard.x - tx, hazard.y - ty) - hazard.radius - HAND_SPAN),
-                              max(0.0, tz - HAND_SPAN - hazard.height)) < clear
-                   for tx, ty, tz in _home_tcps(self.embodiment)):
+            if not self._below_hands(hazard, clear):
                 continue
             return
         raise _Infeasible()
@@ -538,7 +564,8 @@ class _Draw:
 
     def _suite_collaborative(self, roles: dict[str, _Body]) -> None:
         rng = self.rng
-        distance = rng.choice((0.0, 0.01, 0.02))
+        # two hands on one object work close together; one arm keeps clear of the other
+        distance = rng.choice((0.0, 0.01, 0.02) if self.task in BIMANUAL_TASKS else (0.06, 0.08, 0.1))
         self.lines.append(f"constrain arms: separation(left_arm, right_arm) >= {_cm(distance)} "
                           "warn 3 cm cost quadratic")
         self.lines.append("constrain separation(left_gripper, right_gripper) >= 0 warn 2 cm")
