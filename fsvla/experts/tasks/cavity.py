@@ -34,6 +34,7 @@ from ..skills import (
     free_speed,
     gentle,
     load_reach,
+    reach_ceiling,
     transit,
 )
 from ..style import Style
@@ -208,17 +209,20 @@ def release_pose(world: World, arm: str, obj: str, target: str, clear: float = 0
 
 
 def _holds(world: World, arm: str, obj: str) -> bool:
-    """Whether ``obj`` is between the fingers: its box within 2 cm of the TCP."""
+    """Whether the hand holds ``obj``: its box within HELD_WITHIN of the TCP, and the
+    squeeze felt (a grasp that missed leaves the hand just above the object)."""
     lo, hi = world.bounds(obj)
-    return box_distance(world.current_pose(arm).p, lo, hi) <= HELD_WITHIN
+    return (box_distance(world.current_pose(arm).p, lo, hi) <= HELD_WITHIN
+            and world.hand_force(arm, obj) > 0.0)
 
 
 def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
                     retreat: float = 0.1) -> Plan:
     """Carry the held ``obj`` over ``target``'s cavity, come down (guarded) to the lowest
     pose the hand stays clear of the container at (:func:`release_pose`), open the fingers
-    a little, and back off straight up. Nothing when the hand does not hold ``obj`` (a
-    grasp that missed: the release pose of an object on the table is meaningless)."""
+    a little, and back off straight up (as far as the arm reaches). Nothing more when the
+    hand does not hold ``obj`` (a grasp that missed: the release pose of an object on the
+    table is meaningless, and a small arm sent up out of its reach swings into things)."""
     if not _holds(world, arm, obj):
         return
     fragile = force_watched(world, obj)
@@ -253,8 +257,10 @@ def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
     yield Segment(grippers={arm: opening},
                   gripper_steps=style.gripper_steps * (2 if fragile else 1),
                   settle=style.settle, label="release")
-    yield Segment({arm: world.current_pose(arm).moved(retreat * UP)}, speed=free_speed(style),
-                  label="retreat")
+    now = world.current_pose(arm)
+    up = reach_ceiling(world, arm, now.p, now.R, float(now.p[2]) + retreat)  # a small arm's
+    yield Segment({arm: Pose(np.array([now.p[0], now.p[1], max(up, float(now.p[2]))]), now.R)},
+                  speed=free_speed(style), label="retreat")
 
 
 __all__ = ["hand_points", "object_points", "place_in_cavity", "release_pose"]

@@ -114,11 +114,12 @@ def _insert_into_cavity(world: World, style: Style, obj: str, target: str) -> Pl
     yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
     if style.avoid_hazards:  # the hand stays clear of the rim; the object drops the rest
         yield from place_in_cavity(world, style, arm, obj, target)
-    else:  # careless: onto the floor, the hand down into the mouth whatever it meets
-        cavity = world.asset(target).cavity
-        centre = world.to_world(target, cavity.pose.position)
-        floor = float(centre[2]) - float(getattr(cavity, "half_length", 0.0))
-        yield from place(world, style, arm, obj, np.array([centre[0], centre[1], floor]))
+        return
+    # careless: onto the floor, the hand down into the mouth whatever it meets
+    cavity = world.asset(target).cavity
+    centre = world.to_world(target, cavity.pose.position)
+    floor = float(centre[2]) - float(getattr(cavity, "half_length", 0.0))
+    yield from place(world, style, arm, obj, np.array([centre[0], centre[1], floor]))
     yield from retreat_home(world, style, arm)
 
 
