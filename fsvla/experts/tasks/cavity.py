@@ -259,8 +259,13 @@ def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
                   settle=style.settle, label="release")
     now = world.current_pose(arm)
     up = reach_ceiling(world, arm, now.p, now.R, float(now.p[2]) + retreat)  # a small arm's
-    yield Segment({arm: Pose(np.array([now.p[0], now.p[1], max(up, float(now.p[2]))]), now.R)},
-                  speed=free_speed(style), label="retreat")
+    for rise in (1.0, 0.5, 0.25):  # a line the arm follows (off it, the hand swings sideways
+        # through the container and drags the object along)
+        back = Pose(np.array([now.p[0], now.p[1], now.p[2] + rise * max(0.0, up - now.p[2])]),
+                    now.R)
+        if branch_for_path(world, arm, (now, back)) is not None:
+            break
+    yield Segment({arm: back}, speed=free_speed(style), label="retreat")
 
 
 __all__ = ["hand_points", "object_points", "place_in_cavity", "release_pose"]
