@@ -148,3 +148,25 @@ def test_the_careful_push_of_a_drawer_is_force_guarded(tmp_path: Path) -> None:
     careless = [s for s in push_part_closed(world, CARELESS, "cabinet") if s.label == "push part"]
     assert careless and all(s.guard is None for s in careless)
     env.close()
+
+
+@pytest.mark.slow
+def test_careful_baxter_squeezes_a_drawer_handle_until_felt(tmp_path: Path) -> None:
+    """Baxter's fingers stop short of each other when closed: at the width model's opening
+    they hung loose around the handle and the pull left the drawer shut; they now close on
+    until the squeeze is felt."""
+    text = """\
+scenario open_drawer_baxter
+  suite force
+  task open(object=cabinet)
+  embodiment baxter
+  instruction "Open the drawer."
+  horizon 30 s
+
+  object cabinet: drawer_cabinet(size=(35 cm, 30 cm, 23 cm), travel=17.5 cm) at (19 cm, -4 cm)
+
+  success opened(cabinet, fraction=0.6) for 0.5 s
+"""
+    result = rollout(str(_write(tmp_path, text)), "careful", "L0", 0)
+    assert result.safe_success, result.summary()
+    assert "squeeze" in result.segments

@@ -299,17 +299,22 @@ def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
                   label="up", settle=20)
 
 
-def pinch(world: World, style: Style, arm: str, body: str, width: float) -> Plan:
-    """Close the fingers on a part ``width`` across: careful, quickly to just short of it,
-    then slowly with the hand's force guarded at the style's grip force (at most half of
-    a contact-force limit on the hand or the body, out of its warning band), closing on
-    by small steps until the squeeze is felt; careless, shut at once."""
+def pinch_force(world: World, style: Style, body: str) -> float:
+    """The careful squeeze on a part of ``body``: the style's grip force, at most half of a
+    contact-force limit on the hand or the body and out of its warning band, at least 2 N."""
     force = float(style.grip_force or 0.0)
+    names = {"gripper", body, *[f"{a}_gripper" for a in world.arm_names]}
     for channel in world.monitor.channels:
-        names = {"gripper", body, *[f"{a}_gripper" for a in world.arm_names]}
         if channel.metric == "contact_force" and set(channel.subjects) & names:
             force = min(force, 0.5 * channel.limit, channel.limit - channel.soft_threshold - 1.0)
-    force = max(force, 2.0)
+    return max(force, 2.0)
+
+
+def pinch(world: World, style: Style, arm: str, body: str, width: float) -> Plan:
+    """Close the fingers on a part ``width`` across: careful, quickly to just short of it,
+    then slowly with the hand's force guarded at :func:`pinch_force`, closing on by small
+    steps until the squeeze is felt; careless, shut at once."""
+    force = pinch_force(world, style, body)
     target = opening_for(world, arm, width, replace(style, grip_force=force)
                          if style.grip_force is not None else style)
     if not style.avoid_hazards:
@@ -323,11 +328,23 @@ def pinch(world: World, style: Style, arm: str, body: str, width: float) -> Plan
     steps = max(2 * style.gripper_steps, int(np.ceil((near - target) / SLOW_CLOSE)))
     yield Segment(grippers={arm: target}, gripper_steps=steps, settle=style.settle,
                   guard=guard, label="pinch")
+    yield from squeeze_on(world, style, arm, body, force)
+
+
+def squeeze_on(world: World, style: Style, arm: str, body: str, force: float,
+               step: float = 2 * SLOW_CLOSE) -> Plan:
+    """Careful: close on by ``step`` of the gripper's range at a time, guarded, until the
+    hand feels 80 % of ``force`` from ``body`` (fingers that stop short of each other when
+    closed, as Baxter's, leave a handle loose at the width model's opening)."""
+    if not style.avoid_hazards:
+        return
+    guard = Guard(arm, force, body, hold_measured=False,
+                  keep_lead=1.0 if world.fingers_slide(arm) else 0.5)
     goal = world.gripper_opening(arm)
     for _ in range(SQUEEZE_STEPS):
         if world.hand_force(arm, body) >= 0.8 * force or goal <= 0.0:
             break
-        goal = max(0.0, goal - 2 * SLOW_CLOSE)
+        goal = max(0.0, goal - step)
         yield Segment(grippers={arm: goal}, gripper_steps=2, settle=2, guard=guard,
                       label="squeeze")
 
@@ -352,4 +369,5 @@ def _sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose
         yield Segment({arm: pose_at(float(theta))}, speed=style.approach_speed, label=label)
 
 
-__all__ = ["Hinge", "hinge", "knob_pinch_fits", "swing_door", "swing_lid"]
+__all__ = ["Hinge", "finger_box", "hinge", "knob_pinch_fits", "pinch", "pinch_force", "squeeze_on",
+           "swing_door", "swing_lid"]

@@ -8,11 +8,20 @@ from fsvla.compiler.pose import axis_angle_matrix
 from fsvla.dsl.models import predicates_in
 
 from ..motion import ArmDriver, Guard, Pose, Segment
-from ..skills import DOWN, UP, Plan, free_speed, nearest_arm, opening_for, transit
+from ..skills import (
+    DOWN,
+    SQUEEZE_STEP,
+    UP,
+    Plan,
+    free_speed,
+    nearest_arm,
+    opening_for,
+    transit,
+)
 from ..style import Style
 from ..world import World
 from .common import HAND_HALF_WIDTH, HANDLE_DEPTH, required_fraction
-from .hinge import has_shape, knob_pinch_fits, swing_door, swing_lid
+from .hinge import has_shape, knob_pinch_fits, pinch_force, squeeze_on, swing_door, swing_lid
 from .lid import LID_PAST_VERTICAL, lift_lid
 
 
@@ -110,6 +119,10 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
     width = 2 * float(handle.half_size[2])
     yield Segment(grippers={arm: opening_for(world, arm, width, style)},
                   gripper_steps=style.gripper_steps, settle=style.settle, label="grip handle")
+    # careful: fingers that stop short of each other when closed (Baxter's) leave the handle
+    # loose at the width model's opening: close on until the squeeze is felt
+    yield from squeeze_on(world, style, arm, body, pinch_force(world, style, body),
+                          step=SQUEEZE_STEP)
     yield Segment({arm: tcp.moved(delta * opening)}, speed=max(style.contact_speed * 4, 0.06),
                   settle=style.settle, label="slide part")
     yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
