@@ -182,7 +182,7 @@ TILTS = (0.0, 0.5, 0.9)
 #: not stop at the touch).
 CARELESS_GAP = -0.01
 #: Careful: the fastest turn (rad/s) of a hand carrying a long object by its end.
-CARRY_TURN = 0.4
+CARRY_TURN = 0.8
 #: What an exchange that misses a required alignment of the hands loses in rank (m).
 UNALIGNED = 1.0
 #: How much clearance (m) beyond a separation limit's warning band the careful arms keep.
@@ -214,13 +214,21 @@ def _meeting_options(world: World, style: Style, obj: str, giver: str,
     return out
 
 
-def _end_options(bar: _Bar, world: World, giver: str, toward: NDArray[np.float64]) -> list[float]:
-    """The ends (+1: along the long axis, -1: against it) the giver may take, the one its
-    hand turns less to hold the object out toward the taker first (then the nearer)."""
-    def key(e: float) -> tuple[float, float]:
+def _end_options(bar: _Bar, world: World, giver: str, toward: NDArray[np.float64],
+                 inset: float = END_GRASP) -> list[float]:
+    """The ends (+1: along the long axis, -1: against it) the giver may take: one its
+    hand comes straight down onto from 10 cm above first (near its base, a Panda's hand
+    cannot: the line down drives its elbow onto a limit), then the one its hand turns
+    less to hold the object out toward the taker, then the nearer."""
+    lift = np.array([0.0, 0.0, 0.3 * bar.half[2]])
+
+    def key(e: float) -> tuple[bool, float, float]:
+        grip = top_down_grasp(world, giver, bar.centre + e * (bar.half[0] - inset) * bar.along
+                              + lift, bar.across, 2 * float(bar.half[1])).pose
+        down = branch_for_path(world, giver, (grip.moved(0.1 * UP), grip)) is not None
         turn = abs(_yaw_between(-e * bar.along, toward))
         near = float(np.linalg.norm((bar.centre + e * bar.along - world.base_position(giver))[:2]))
-        return (round(turn, 3), near)
+        return (not down, round(turn, 3), near)
 
     return sorted((1.0, -1.0), key=key)
 
