@@ -22,6 +22,8 @@ from fsvla.compiler.pose import matrix_to_quat, quat_to_matrix, rotation_angle, 
 
 #: Largest joint step (rad) between two IK solves of one segment before it is split.
 MAX_JOINT_STEP = 0.12
+#: A straight segment's pose that IK misses by more than this (m) is out of reach.
+OUT_OF_REACH = 0.02
 #: How far inside its joint limits (rad or m) a free-space move's goal configuration stays.
 LIMIT_MARGIN = 0.15
 #: How far inside its joint limits (rad or m) a line that must be followed stays, and the
@@ -311,6 +313,10 @@ class ArmDriver:
                 result = retry
             if not result.ok(position_tol=5e-3, rotation_tol=5e-2):
                 self.ik_misses += 1
+                # a pose well out of reach: the closest answer the solver wandered to may
+                # be a swing across the workspace in one control step; stay where it is
+                if result.position_error > OUT_OF_REACH and _jump(result, self.q) > MAX_JOINT_STEP:
+                    return self.q.copy()
         return np.clip(result.qpos, self.kin.limits[:, 0], self.kin.limits[:, 1])
 
 
