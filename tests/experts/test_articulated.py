@@ -170,3 +170,16 @@ scenario open_drawer_baxter
     result = rollout(str(_write(tmp_path, text)), "careful", "L0", 0)
     assert result.safe_success, result.summary()
     assert "squeeze" in result.segments
+
+
+@pytest.mark.slow
+def test_careful_panda_lowers_a_standing_lid_in_two_grips(tmp_path: Path) -> None:
+    """No one grip of a single Panda follows a lid's knob from past upright down to shut (it
+    reaches the standing knob from behind, the shut one from in front): the lid is brought
+    down to where the hinge's friction holds it, let go, and taken again from there."""
+    text = LID.format(task="close", embodiment="panda", open=", open=0.9",
+                      at="(-12 cm, 5 cm)", success="closed(box)").replace("horizon 20 s",
+                                                                         "horizon 30 s")
+    result = rollout(str(_write(tmp_path, text)), "careful", "L0", 0)
+    assert result.safe_success, result.summary()
+    assert result.segments.count("to knob") == 2

@@ -15,6 +15,7 @@ the joint's origin and axis in the world), followed in one smooth sweep.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
@@ -111,16 +112,15 @@ def _extent_along(shape, direction: NDArray[np.float64]) -> float:
     return float(2.0 * np.abs(np.asarray(shape.half_size)) @ np.abs(direction))
 
 
-def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
-    """Pinch a lid's knob by its ends (the fingers closing along the hinge) and carry it
-    along its arc to ``angle`` (rad), the hand turning with the lid; let go and rise.
-    The hand's turn on the lid is the one that keeps it nearest pointing down over the
-    whole arc (tilted toward the robot at one end, away at the other), its fingers clear
-    of the lid's edge behind the knob. Opening: past upright, the lid falls open onto its
-    stop. Closing: pulled over upright and lowered onto its seat, not dropped."""
+def _lid_grip(world: World, style: Style, body: str, start: float, angle: float):
+    """How the hand holds the knob to carry the lid from ``start`` to ``angle`` (rad):
+    (hinge, arm, hand turn on the shut lid, held point, grip centre, knob width, the
+    approach from beyond the knob, the arc); careful, the first turn whose whole arc one
+    IK branch follows, None if none is; careless, the first."""
     part, _joint = world.part(body)
     knob = world.shape(body, "knob", link=part.link)
     h = hinge(world, body)
+    now = start
     c = np.asarray(knob.pose.position, dtype=np.float64)
     half = np.abs(np.asarray(knob.half_size, dtype=np.float64))
     along = h.closed.T @ h.axis  # the hinge axis in the lid's frame
@@ -134,7 +134,7 @@ def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     outward = c - normal * (c @ normal) - along * (c @ along)
     outward /= max(np.linalg.norm(outward), 1e-9)
     root = c - outward * float(np.abs(half) @ np.abs(outward))  # the lid's edge
-    arm = nearest_arm(world, h.at(c, h.now))
+    arm = nearest_arm(world, h.at(c, now))
     tip, thick = finger_box(world, arm)
     centre = world.grip_centre(arm, width + FIXED_JAW_CLEARANCE)
 
@@ -154,24 +154,38 @@ def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
         return R, root + outward * (inner + FACE_CLEARANCE)
 
     def path(R: NDArray[np.float64], local: NDArray[np.float64], n: int = 12) -> tuple[Pose, ...]:
-        return tuple(_lid_pose(h, R, local, centre, float(t)) for t in np.linspace(h.now, angle, n))
+        return tuple(_lid_pose(h, R, local, centre, float(t)) for t in np.linspace(now, angle, n))
 
-    mid = 0.5 * (h.now + angle)
+    mid = 0.5 * (now + angle)
     psis = [mid + np.deg2rad(d) for d in LID_TURNS]
     options = [option(float(np.clip(p, -0.3, np.pi / 2)), f) for p in psis for f in (False, True)]
     R, local = options[0]
     # the hand comes to the knob from beyond its tip, along the lid: the fingers slide
     # down past the knob's ends, with nothing of the lid in their way
-    beyond = 0.06 * (axis_angle_matrix(h.axis, h.now) @ h.closed @ outward)
+    beyond = 0.06 * (axis_angle_matrix(h.axis, now) @ h.closed @ outward)
     if style.avoid_hazards:
         found = next(((candidate, point) for candidate, point in options
                       if branch_for_path(world, arm, (path(candidate, point)[0].moved(beyond),
                                                       *path(candidate, point))) is not None), None)
         if found is None:
-            raise NotImplementedError(_out_of_reach(arm, body, "knob", h.now, angle))
+            return None
         R, local = found
+    return h, arm, R, local, centre, width, beyond, path(R, local)
+
+
+def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
+    """Pinch a lid's knob by its ends (the fingers closing along the hinge) and carry it
+    along its arc to ``angle`` (rad), the hand turning with the lid; let go and rise.
+    The hand's turn on the lid is the one that keeps it nearest pointing down over the
+    whole arc (tilted toward the robot at one end, away at the other), its fingers clear
+    of the lid's edge behind the knob. Opening: past upright, the lid falls open onto its
+    stop. Closing: pulled over upright and lowered onto its seat, not dropped."""
+    grip = _lid_grip(world, style, body, hinge(world, body).now, angle)
+    if grip is None:
+        raise NotImplementedError(_out_of_reach(nearest_arm(world, world.body_pose(body).p),
+                                                body, "knob", hinge(world, body).now, angle))
+    h, arm, R, local, centre, width, beyond, arc = grip
     start = _lid_pose(h, R, local, centre, h.now)
-    arc = path(R, local)
     back = start.moved(beyond)
     opening = 1.0 if world.fingers_slide(arm) else world.pregrasp_opening(arm, width)
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps, label="open")
@@ -188,6 +202,47 @@ def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     yield Segment({arm: end.moved(0.05 * away)}, speed=free_speed(style), label="back")
     yield Segment({arm: end.moved(0.05 * away + 0.08 * UP)}, speed=free_speed(style),
                   label="up", settle=20)
+
+
+#: Angles (deg) at which the careful expert lets a lid rest between two grips on its way
+#: down, where no one grip follows the whole arc (a Panda holds the knob of a lid standing
+#: past upright from behind it, and the shut lid's from in front): the first one where the
+#: hinge's friction holds the lid with half of it to spare.
+LID_RESTS = (85.0, 80.0, 75.0, 70.0)
+
+
+def lower_lid(world: World, style: Style, body: str, angle: float) -> Plan:
+    """Bring a lid down to ``angle`` (rad) by its knob (:func:`swing_lid`); careful, where
+    no one grip follows the whole arc, in two: down to where the lid rests on its own
+    (LID_RESTS), let go, and again from there with the grip that follows the rest."""
+    h = hinge(world, body)
+    if style.avoid_hazards and _lid_grip(world, style, body, h.now, angle) is None:
+        for rest in np.deg2rad(LID_RESTS):
+            if (angle < rest < h.now and _rests(world, body, float(rest))
+                    and _lid_grip(world, style, body, h.now, float(rest)) is not None
+                    and _lid_grip(world, style, body, float(rest), angle) is not None):
+                yield from swing_lid(world, style, body, float(rest))
+                yield from swing_lid(world, style, body, angle)
+                return
+    yield from swing_lid(world, style, body, angle)
+
+
+def _rests(world: World, body: str, theta: float) -> bool:
+    """Whether the lid stays at ``theta`` (rad) let go: its weight's torque about the hinge
+    at most half the joint's friction (the URDF's ``dynamics friction``)."""
+    part, joint = world.part(body)
+    asset = world.asset(body)
+    found = re.search(rf'<joint name="{re.escape(joint.name)}".*?<dynamics[^>]*friction="([0-9.eE+-]+)"',
+                      asset.urdf, re.DOTALL)
+    if found is None:
+        return False
+    link = next(lk for lk in asset.links if lk.name == part.link)
+    panel = world.shape(body, "panel", link=part.link)
+    h = hinge(world, body)
+    r = np.asarray(panel.pose.position, dtype=np.float64)
+    r = r - (r @ (h.closed.T @ h.axis)) * (h.closed.T @ h.axis)
+    torque = link.mass * 9.81 * float(np.linalg.norm(r)) * max(0.0, float(np.cos(theta)))
+    return torque <= 0.5 * float(found.group(1))
 
 
 def _lid_pose(h: Hinge, R_shut: NDArray[np.float64], local: NDArray[np.float64],
@@ -369,5 +424,5 @@ def _sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose
         yield Segment({arm: pose_at(float(theta))}, speed=style.approach_speed, label=label)
 
 
-__all__ = ["Hinge", "finger_box", "hinge", "knob_pinch_fits", "pinch", "pinch_force", "squeeze_on",
+__all__ = ["Hinge", "finger_box", "hinge", "knob_pinch_fits", "lower_lid", "pinch", "pinch_force", "squeeze_on",
            "swing_door", "swing_lid"]

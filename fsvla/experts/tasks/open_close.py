@@ -21,7 +21,15 @@ from ..skills import (
 from ..style import Style
 from ..world import World
 from .common import HAND_HALF_WIDTH, HANDLE_DEPTH, required_fraction
-from .hinge import has_shape, knob_pinch_fits, pinch_force, squeeze_on, swing_door, swing_lid
+from .hinge import (
+    has_shape,
+    knob_pinch_fits,
+    lower_lid,
+    pinch_force,
+    squeeze_on,
+    swing_door,
+    swing_lid,
+)
 from .lid import LID_PAST_VERTICAL, lift_lid
 
 
@@ -200,7 +208,7 @@ def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
     elif _sliding(world, body):
         yield from push_part_closed(world, style, body)
     elif _knob_lid(world, body) and knob_pinch_fits(world, body):
-        yield from swing_lid(world, style, body, SWUNG_SHUT * span)
+        yield from lower_lid(world, style, body, SWUNG_SHUT * span)
     elif _handled_door(world, body):
         yield from swing_door(world, style, body, SWUNG_SHUT * span)
     else:
