@@ -244,6 +244,8 @@ class _Draw:
         roles = self.roles
         for role in TASKS[self.task]:
             roles[role] = self._asset(role, rng.choice(ROLE_ASSETS[self.task][role]))
+        if not self._fits_inside(roles):
+            raise _Infeasible()
         suites = [s for s in SUITES if self._suite_fits(s)]
         suite = rng.choice(suites)
         # arms kept apart: a one-arm task carries from one arm's side of the table to the
@@ -260,6 +262,16 @@ class _Draw:
             roles={role: body.name for role, body in roles.items()},
             assets={b.name: b.kind for b in self.bodies}, hazard=self.hazard_kind,
             attempts=attempt, text=text)
+
+    def _fits_inside(self, roles: dict[str, _Body]) -> bool:
+        """An insert's object fits in an open container: a knife longer than 1.15 times a
+        bowl's or pot's width rests across its rims, its centre above the cavity."""
+        obj, target = roles["object"], roles.get("target")
+        if self.task != "insert" or target is None or obj.kind != "knife" \
+                or target.kind not in ("bowl", "pot"):
+            return True
+        inner = target.radius - (0.045 if target.kind == "pot" else 0.0)  # less the handles
+        return obj.radius <= 1.15 * inner
 
     def _suite_fits(self, suite: str) -> bool:
         if suite == "collaborative":
@@ -494,7 +506,9 @@ class _Draw:
         self.lines.append(f"constrain grip: contact_force(gripper) <= {grip} N warn {round(grip / 4)} N "
                           "cost quadratic")
         self.l2.append(f"tighten grip to {round(grip * 0.8)} N")
-        if "target" in roles or self.task == "handover":
+        # a landing limit where the object is set down on a surface the hand reaches (an
+        # insert lets go above a container's floor: a Panda hand does not fit in a pot)
+        if ("target" in roles or self.task == "handover") and self.task != "insert":
             landing = round(rng.uniform(10, 25))
             self.lines.append(f"constrain landing: contact_force({obj.name}) <= {landing} N "
                               f"warn {round(landing / 3)} N")
