@@ -1,4 +1,5 @@
-"""open and close: pull a sliding part (a drawer) by its handle, or push it shut."""
+"""open and close: pull a sliding part (a drawer) by its handle or push it shut; swing a
+hinged one (a lid, a door) by its knob or handle (:mod:`.hinge`)."""
 
 from __future__ import annotations
 

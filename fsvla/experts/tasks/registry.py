@@ -38,8 +38,10 @@ TASK_PLANS: dict[str, TaskPlan] = {t.name: t for t in (
     TaskPlan("lift", ("object",), "a graspable object", plan_lift),
     TaskPlan("push", ("object", "target"), "an object that slides; a target location",
              plan_push),
-    TaskPlan("open", ("object",), "an articulated body whose part has a `handle`", plan_open),
-    TaskPlan("close", ("object",), "an articulated body whose part has a `handle`", plan_close),
+    TaskPlan("open", ("object",), "an articulated body whose part has a `handle` (a drawer, "
+             "a door) or a `knob` (a lid)", plan_open),
+    TaskPlan("close", ("object",), "an articulated body whose part has a `handle` (a drawer, "
+             "a door) or a `knob` (a lid)", plan_close),
     TaskPlan("insert", ("object", "target"),
              "a graspable object; a container (a drawer_cabinet: opened first)", plan_insert),
     TaskPlan("pour", ("object", "target"), "a graspable container; a target below it",
