@@ -230,6 +230,7 @@ class Joint(_Model):
     axis: Vec3 = (0.0, 0.0, 1.0)
     lower: float = 0.0
     upper: float = 0.0
+    friction: float = Field(default=0.0, ge=0.0)  # <dynamics friction>: N·m (revolute) or N
 
 
 class Part(_Model):

@@ -195,7 +195,21 @@ def _joint(element: ET.Element, scale: float) -> Joint:
         axis=axis,
         lower=lower,
         upper=upper,
+        friction=_friction(element, name),
     )
+
+
+def _friction(element: ET.Element, joint: str) -> float:
+    """A joint's ``<dynamics friction>`` (0 without one)."""
+    dynamics = element.find("dynamics")
+    text = "0" if dynamics is None else dynamics.get("friction", "0")
+    try:
+        value = float(text)
+    except ValueError:
+        raise UrdfError(f"joint {joint!r}: <dynamics friction={text!r}> is not a number") from None
+    if value < 0.0:
+        raise UrdfError(f"joint {joint!r}: <dynamics friction> must not be negative (got {value})")
+    return value
 
 
 def _check_tree(links: list[Link], joints: list[Joint]) -> str:

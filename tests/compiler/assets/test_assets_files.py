@@ -154,6 +154,23 @@ def test_urdf_file_loads_with_its_movable_parts(scenario_dir):
     )
 
 
+
+@pytest.mark.parametrize(("dynamics", "friction"), [("", 0.0), ('<dynamics damping="0.1" friction="0.3"/>', 0.3)])
+def test_a_joint_keeps_its_urdf_friction(scenario_dir, dynamics, friction):
+    """What holds a lid standing where it is let go (an expert reads it)."""
+    text = URDF.format(visual="bracket.obj", collision="brick.stl").replace("</joint>", f"{dynamics}</joint>")
+    (scenario_dir / "hinged.urdf").write_text(text)
+    asset = build_asset("urdf", {"path": "hinged.urdf"}, base_dir=scenario_dir)
+    assert next(j for j in asset.joints if j.name == "hinge").friction == friction
+
+
+def test_a_negative_joint_friction_is_rejected(scenario_dir):
+    text = URDF.format(visual="bracket.obj", collision="brick.stl").replace(
+        "</joint>", '<dynamics friction="-1"/></joint>')
+    (scenario_dir / "hinged.urdf").write_text(text)
+    with pytest.raises(UrdfError, match="must not be negative"):
+        build_asset("urdf", {"path": "hinged.urdf"}, base_dir=scenario_dir)
+
 @pytest.mark.parametrize(
     ("reference", "error", "message"),
     [
