@@ -168,16 +168,6 @@ class ArmGap:
                     best = min(best, signed_distance(x, y) - need)
         return best
 
-    def distance(self, qa: NDArray[np.float64], qb: NDArray[np.float64]) -> float:
-        """Smallest distance (m) between the watched links over the channels, for arm
-        ``a`` at ``qa`` and ``b`` at ``qb``; +inf with no separation limit."""
-        best = float("inf")
-        for ia, ib, _ in self._checks:
-            for x in self._objects(self.arms[0], qa, ia):
-                for y in self._objects(self.arms[1], qb, ib):
-                    best = min(best, signed_distance(x, y))
-        return best
-
     def aligned(self, qa: NDArray[np.float64], qb: NDArray[np.float64],
                 slack: float = 0.005) -> bool:
         """Whether every ``aligned`` a requirement asks of the two arms holds, ``slack`` (m)

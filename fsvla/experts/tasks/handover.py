@@ -153,7 +153,7 @@ class _Bar:
 class _Exchange:
     """Where a long object changes hands: its middle there, the inset of the giver's hand
     from its end, how far from the middle the taker takes it (careful: as far as the giver;
-    careless: at the middle or closer to the giver, leaving the arms no room apart),
+    careless: at the middle, leaving the arms no room apart),
     how far before its take pose (along the approach) the taker's free-space move
     ends (m), and how far the taker's hand leans away from the giver's (rad)."""
 
@@ -177,10 +177,6 @@ ABOVE = (0.1, 0.16, 0.22)
 #: Leans (rad) of the taker's hand away from the giver, tried in turn: Baxter's forearms
 #: stand 40 cm tall above hands that point down, and two of them side by side touch.
 TILTS = (0.0, 0.5, 0.9)
-#: Careless: how far apart (m) the arms are, on their models, where the taker takes the
-#: object beside the giver's hand: a centimetre into each other (the careless hand does
-#: not stop at the touch).
-CARELESS_GAP = -0.01
 #: Careful: the fastest turn (rad/s) of a hand carrying a long object by its end.
 CARRY_TURN = 0.8
 #: What an exchange that misses a required alignment of the hands loses in rank (m).
@@ -256,29 +252,6 @@ def _taker_grasp(world: World, taker: str, bar: _Bar, middle: NDArray[np.float64
     return Grasp(Pose(point, R), 2 * float(bar.half[1]), approach)
 
 
-def _beside(world: World, giver: str, taker: str, bar: _Bar, toward: NDArray[np.float64],
-            above: float) -> float:
-    """Careless, once the giver holds the object out along ``toward``: how far from its
-    middle (m, toward the taker) the taker takes it: at the middle, where it balances,
-    or, where the arms would still be apart there on their models, farther toward the
-    giver's hand until they touch (CARELESS_GAP), on the branch the taker will come in
-    on: no room kept for a separation limit."""
-    gap = ArmGap(world, giver, taker)
-    if not gap.watched:
-        return 0.0
-    q_giver = np.asarray(world.arm_joints(giver), dtype=np.float64)
-    reach = float(bar.half[0]) - INSETS[0]
-    for out in np.arange(0.0, -reach, -0.005):
-        grasp = _taker_grasp(world, taker, bar, bar.centre, toward, float(out))
-        q_over = branch_for_path(world, taker, (grasp.pose.moved(-above * grasp.approach),
-                                                grasp.pose))
-        if q_over is None:
-            continue
-        if gap.distance(q_giver, _joints_at(world, taker, q_over, grasp.pose)) <= CARELESS_GAP:
-            return float(out)
-    return 0.0
-
-
 def _exchange_margin(world: World, gap: ArmGap, giver: str, taker: str, q_giver,
                      grasp: Grasp, above: float) -> float:
     """The arms' smallest separation margin (:class:`ArmGap`) while the giver holds still
@@ -304,8 +277,8 @@ def _plan_exchange(world: World, style: Style, obj: str, giver: str,
     a separation limit on the arms, the first option (end, inset, meeting point, approach
     height) at which the arms' links keep the limit and its warning band with GAP_SLACK
     to spare, predicted on the arms' models (else the one that keeps the most); careless,
-    the first end and meeting point; its take point is chosen once the giver holds the
-    object out (:func:`_beside`)."""
+    the first end and meeting point, and the taker takes the object at its middle, next
+    to the giver's hand (no room kept)."""
     bar = _Bar.of(world, obj)
     toward = horizontal(world.base_position(taker) - world.base_position(giver))
     ends = _end_options(bar, world, giver, toward)
@@ -345,7 +318,7 @@ def _plan_exchange(world: World, style: Style, obj: str, giver: str,
 def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, taker: str) -> Plan:
     """A long object: the giver takes one end from above, brings the object over the
     middle with its long axis from arm to arm (turning its hand about the vertical), the
-    taker takes the other end from above (careless: the middle, or beside the giver's arm),
+    taker takes the other end from above (careless: at its middle),
     the giver lets go and backs off, the taker puts it on the support. A Panda can hold
     out a top-down hand there; a hand pointing sideways at the object it cannot. Careful,
     with a separation limit on the arms, the end, the meeting point and the taker's
@@ -388,8 +361,7 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
     # aimed at the object as it is now (it may have pivoted a little in the giver's hand)
     now = _Bar.of(world, obj)
     line = now.line if now.line @ toward >= 0 else -now.line
-    take_at = meet.take_at if style.avoid_hazards else _beside(world, giver, taker, now, line,
-                                                                meet.above)
+    take_at = meet.take_at if style.avoid_hazards else 0.0  # careless: the middle
     take = _taker_grasp(world, taker, now, now.centre, line, take_at, meet.tilt)
     above = meet.above
     gap = ArmGap(world, giver, taker)
