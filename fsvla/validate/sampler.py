@@ -595,8 +595,8 @@ class _Draw:
         elif self.task == "handover":
             first = "aligned(left_gripper, right_gripper, within=15 cm)"
             then = f"grasped({obj}, right)"
-        else:  # set down, not dropped
-            first, then = f"on({obj}, {target})", f"released({obj})"
+        else:  # set down, not dropped (a grasp's fingers may lose touch on the table: no event)
+            first, then = f"on({obj}, {target})", f"released({obj}) and lifted({obj}, by=2 cm)"
         self.lines.append(f"require pre: {first} before {then}")
         self.l2.append(f"couple pre within {self.rng.choice((10, 15, 20))} s")
 
