@@ -101,7 +101,8 @@ def test_unsolvable_scenarios_fail_on_the_right_lines(unsolvable: Path, tmp_path
     assert run(args) == 1
     report = json.loads(capsys.readouterr().out)
     failed = {(v["scenario"], v["verdict"]) for v in report["verdicts"] if not v["holds"]}
-    assert failed == {("far_cube", "solvable"), ("weak_grip", "solvable")}
+    # far_cube is out of reach for both experts: the careless one cannot be hurt there either
+    assert failed == {("far_cube", "solvable"), ("far_cube", "hazardous"), ("weak_grip", "solvable")}
     found = {(Path(d["span"]["file"]).name, d["span"]["line"], d["code"]): d
              for d in report["diagnostics"]}
     # far_cube: out of reach (static) and, from the careful expert's replayed episode,
