@@ -72,6 +72,17 @@ def test_careful_press_stops_at_the_force_it_feels(tmp_path, x, y, limit, warn):
     assert careless.violation, careless.summary()
 
 
+
+@pytest.mark.slow
+def test_a_soft_arm_holds_its_press_below_the_limit(tmp_path):
+    """Baxter's arm lags its command: held where the guard stopped it, it closed the gap
+    and pressed a 10 N press on to 27 N, across a 26 N limit. The hold eases the
+    command's lead while the hand feels too much."""
+    text = PRESS.replace("embodiment panda", "embodiment baxter").format(
+        x="-33 cm", y="-3 cm", limit=26, warn=6)
+    careful = rollout(_write(tmp_path, "press_block", text), "careful")
+    assert careful.safe_success, careful.summary()
+
 @pytest.mark.slow
 def test_a_bottle_too_wide_for_the_hand_is_lifted_by_its_neck(tmp_path):
     result = rollout(_write(tmp_path, "neck", NECK), "careful")

@@ -19,6 +19,11 @@ PRESS_STEP = 0.001
 PRESS_STEPS = 40
 #: The least force (N) it presses with: ``pressed`` needs a force a sensor tells from noise.
 LEAST_PRESS = 2.0
+#: The careful hold after the press: HOLD_STEPS control steps, the command's lead under
+#: the hand changed by HOLD_STEP (m) at a time; above PRESS_EASE times the force it eases.
+HOLD_STEPS = 20
+HOLD_STEP = 0.0001
+PRESS_EASE = 1.3
 
 
 def press_force(world: World, arm: str, obj: str) -> float:
@@ -57,12 +62,35 @@ def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
             pose = pose.moved(-PRESS_STEP * UP)
             yield Segment({arm: pose}, speed=0.1 * style.contact_speed, guard=guard,
                           label="press")
-        yield Segment(settle=20, label="hold")
+        yield from _hold_press(world, style, arm, obj, R, force)
     else:
         yield Segment({arm: Pose(top, R)}, speed=style.approach_speed, label="touch")
         yield Segment({arm: Pose(top - np.array([0.0, 0.0, 0.01]), R)},
                       speed=style.contact_speed, settle=20, label="press")
     yield from retreat_home(world, style, arm)
+
+
+def _hold_press(world: World, style: Style, arm: str, obj: str, R: np.ndarray,
+                force: float) -> Plan:
+    """Hold the press for HOLD_STEPS steps, the hand's command a little below where the
+    hand is: a soft arm (Baxter's, the Z1's) lags its command, and held where the guard
+    stopped it, it closes the gap and presses on to two or three times the force. The
+    command's lead under the hand grows by HOLD_STEP while the hand feels less than half
+    the force and shrinks while it feels more than PRESS_EASE times it."""
+    lead = HOLD_STEP
+    for _ in range(HOLD_STEPS):
+        felt = world.hand_force(arm, obj)
+        if felt > PRESS_EASE * force:
+            lead -= HOLD_STEP
+        elif felt < 0.5 * force:
+            lead += HOLD_STEP
+        else:
+            yield Segment(settle=1, label="hold")
+            continue
+        lead = min(max(lead, -PRESS_STEP), 3 * PRESS_STEP)
+        here = world.current_pose(arm).p
+        yield Segment({arm: Pose(here - lead * UP, R)}, speed=0.1 * style.contact_speed,
+                      settle=1, label="hold")
 
 
 def _press_frame(world: World, style: Style, arm: str, obj: str, top: np.ndarray) -> np.ndarray:
@@ -81,11 +109,14 @@ def _press_frame(world: World, style: Style, arm: str, obj: str, top: np.ndarray
     if not boxes:
         return default
     level = top + HAND_ABOVE * UP  # the hand's body, just above the top
+    reach = world.hand_reach(arm)
     best: tuple[float, np.ndarray] | None = None
     for yaw in np.deg2rad([90.0, 45.0, 0.0, 135.0]):  # y first: the default
         closing = np.array([np.cos(yaw), np.sin(yaw), 0.0])
         R = world.grasp_frame(arm, DOWN, closing)
-        if branch_for_path(world, arm, (Pose(top + 0.05 * UP, R),)) is None:
+        # reached above the top and on the way down to it, on one branch (a five-joint arm
+        # holds a turned hand high above the button, not down on it)
+        if branch_for_path(world, arm, (Pose(top + 0.05 * UP, R), Pose(top + reach * UP, R))) is None:
             continue
         ends = (level + HAND_HALF_LENGTH * closing, level - HAND_HALF_LENGTH * closing)
         clearance = min(box_distance(p, lo, hi) - margin for lo, hi, margin in boxes for p in ends)
