@@ -272,20 +272,26 @@ class World:
     def hand_reach(self, arm: str) -> float:
         """How far (m) the hand's collision hulls reach past the TCP along its approach
         axis now (closed fingers that stick out below a Panda's TCP touch first)."""
-        kin = self.kinematics(arm)
         tcp = self.current_pose(arm)
         axis = tcp.R @ self.approach_axis(arm)
         reach = 0.0
         for link in self.hand_links(arm):
-            if link not in kin.link_names:
-                continue
-            vertices = kin.link_vertices(kin.link_names.index(link))
-            if vertices is None:
-                continue
-            pose = self.state.robot_link_pose(arm, link)
-            points = vertices @ quat_to_matrix(pose.q).T + np.asarray(pose.p)
-            reach = max(reach, float(np.max((points - tcp.p) @ axis)))
+            points = self.link_points(arm, link)
+            if points is not None:
+                reach = max(reach, float(np.max((points - tcp.p) @ axis)))
         return reach
+
+    def link_points(self, arm: str, link: str) -> NDArray[np.float64] | None:
+        """The vertices of an arm link's collision hull where the link is now (world, m);
+        None for a link without one."""
+        kin = self.kinematics(arm)
+        if link not in kin.link_names:
+            return None
+        vertices = kin.link_vertices(kin.link_names.index(link))
+        if vertices is None:
+            return None
+        pose = self.state.robot_link_pose(arm, link)
+        return vertices @ quat_to_matrix(pose.q).T + np.asarray(pose.p)
 
     def hand_force(self, arm: str, other: str | None = None) -> float:
         """What a force sensor in ``arm``'s hand reads now (N): the largest net contact

@@ -194,13 +194,7 @@ def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     yield from _sweep(world, style, arm, lambda t: _lid_pose(h, R, local, centre, t),
                       h.now, angle, "swing lid")
     yield Segment({}, settle=style.settle, label="hold lid")
-    yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps,
-                  settle=style.settle, label="let go")
-    end = world.current_pose(arm)
-    away = -(end.R @ world.approach_axis(arm))
-    yield Segment({arm: end.moved(0.05 * away)}, speed=free_speed(style), label="back")
-    yield Segment({arm: end.moved(0.05 * away + 0.08 * UP)}, speed=free_speed(style),
-                  label="up", settle=20)
+    yield from _let_go(world, style, arm, opening, 0.05)
 
 
 #: Angles (deg) at which the careful expert lets a lid rest between two grips on its way
@@ -251,6 +245,17 @@ def _lid_pose(h: Hinge, R_shut: NDArray[np.float64], local: NDArray[np.float64],
     return Pose(h.at(local, theta) - R @ centre, R)
 
 
+
+def _let_go(world: World, style: Style, arm: str, opening: float, back: float) -> Plan:
+    """Open to ``opening``, back the hand off ``back`` (m) along its approach, and rise."""
+    yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps,
+                  settle=style.settle, label="let go")
+    end = world.current_pose(arm)
+    away = -(end.R @ world.approach_axis(arm))
+    yield Segment({arm: end.moved(back * away)}, speed=free_speed(style), label="back")
+    yield Segment({arm: end.moved(back * away + 0.08 * UP)}, speed=free_speed(style),
+                  label="up", settle=20)
+
 #: How far back from the TCP (m) the fingers' hulls are measured for their thickness.
 NEAR_TIP = 0.02
 
@@ -259,22 +264,15 @@ def finger_box(world: World, arm: str) -> tuple[float, float]:
     """How far (m) the closed fingers reach past the TCP along the approach, and their half
     thickness across both the approach and the closing axis within NEAR_TIP of the TCP
     (from their collision hulls)."""
-    kin = world.kinematics(arm)
     tcp = world.current_pose(arm)
     a = world.approach_axis(arm)
     third = np.cross(a, world.finger_axis(arm))
     reach, thick = 0.0, 0.0
-    fingers = world.arm_spec(arm).gripper.finger_links
-    for link in fingers:
-        if link not in kin.link_names:
+    for link in world.arm_spec(arm).gripper.finger_links:
+        found = world.link_points(arm, link)
+        if found is None:
             continue
-        vertices = kin.link_vertices(kin.link_names.index(link))
-        if vertices is None:
-            continue
-        pose = world.state.robot_link_pose(arm, link)
-        from fsvla.compiler.pose import quat_to_matrix
-
-        points = (vertices @ quat_to_matrix(pose.q).T + np.asarray(pose.p) - tcp.p) @ tcp.R
+        points = (found - tcp.p) @ tcp.R
         reach = max(reach, float(np.max(points @ a)))
         near = points[points @ a >= -NEAR_TIP]  # the pads, not the jaw's body behind them
         if len(near):
@@ -342,13 +340,7 @@ def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
     yield from pinch(world, style, arm, body, width)
     yield from _sweep(world, style, arm, at, h.now, angle, "swing door")
     yield Segment({}, settle=style.settle, label="hold door")
-    yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps,
-                  settle=style.settle, label="let go")
-    end = world.current_pose(arm)
-    away = -(end.R @ world.approach_axis(arm))
-    yield Segment({arm: end.moved(0.06 * away)}, speed=free_speed(style), label="back")
-    yield Segment({arm: end.moved(0.06 * away + 0.08 * UP)}, speed=free_speed(style),
-                  label="up", settle=20)
+    yield from _let_go(world, style, arm, opening, 0.06)
 
 
 def pinch_force(world: World, style: Style, body: str) -> float:
