@@ -418,10 +418,7 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
     # width model that is off (a jaw that swings, fingers that do not meet when closed)
     # neither crushes the object nor leaves it loose
     force = float(held.grip_force or 0.0)
-    # a jaw on a soft drive swings on past the felt force: it holds half its lead; sliding
-    # fingers hold their command (their squeeze is what holds a heavy load)
-    guard = Guard(arm, force, obj, hold_measured=False,
-                  keep_lead=1.0 if world.fingers_slide(arm) else 0.5)
+    guard = grip_guard(world, arm, force, obj)
     if force_watched(world, obj) or not world.fingers_slide(arm):
         # slowly over the last millimetres: a jaw on a hinge swinging shut at speed knocks
         # the object across the table before it squeezes it
@@ -454,6 +451,14 @@ def close_on(world: World, style: Style, arm: str, obj: str, width: float,
         goal = max(0.0, goal - step)
         yield Segment(grippers={arm: goal}, gripper_steps=style.gripper_steps, settle=2,
                       guard=guard, label="squeeze")
+
+
+def grip_guard(world: World, arm: str, force: float, obj: str) -> Guard:
+    """The guard of a careful grip on ``obj``: it stops the fingers at ``force`` felt from
+    it. A jaw on a soft drive swings on past the felt force: it holds half its lead;
+    sliding fingers hold their command (their squeeze is what holds a heavy load)."""
+    return Guard(arm, force, obj, hold_measured=False,
+                 keep_lead=1.0 if world.fingers_slide(arm) else 0.5)
 
 
 def load_reach(world: World, arm: str, obj: str) -> float:
@@ -501,6 +506,7 @@ __all__ = [
     "grasp_lever",
     "grasp_tip",
     "grip_force",
+    "grip_guard",
     "held_offset",
     "horizontal",
     "load_reach",

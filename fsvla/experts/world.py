@@ -321,6 +321,14 @@ class World:
                   and set(c.subjects) & set(subjects)]
         return min(limits) if limits else None
 
+    def force_allowance(self, *subjects: str) -> float | None:
+        """What a careful contact on any of ``subjects`` may reach (N): half the tightest
+        contact-force limit on them, and out of its warning band (1 N below it); None
+        where no limit watches them."""
+        allowed = [min(0.5 * c.limit, c.limit - c.soft_threshold - 1.0) for c in self.monitor.channels
+                   if c.metric == "contact_force" and set(c.subjects) & set(subjects)]
+        return min(allowed) if allowed else None
+
     def obstacles(self, exclude: tuple[str, ...] = ()) -> list[Obstacle]:
         """Every hazard zone and hazard object as a box with its keep-out distance (the
         largest limit + soft threshold of the channels that reference it)."""

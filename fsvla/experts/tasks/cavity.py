@@ -21,7 +21,7 @@ from itertools import product
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.pose import quat_to_matrix
+from fsvla.compiler.pose import axis_angle_matrix, quat_to_matrix
 
 from ..motion import Guard, Pose, Segment
 from ..skills import (
@@ -78,20 +78,18 @@ def hand_points(world: World, arm: str, gap: float = 0.0) -> NDArray[np.float64]
     """Sample points (TCP frame, m) on the boxes of the arm's links near the TCP, as the
     hand is now, and the fingers' also where they are once each has opened ``gap`` (m)
     farther out along the closing axis (to let go)."""
-    kin = world.kinematics(arm)
     tcp = world.current_pose(arm)
     closing = world.finger_axis(arm)
     fingers = world.arm_spec(arm).gripper.finger_links
     points = []
-    for index, link in enumerate(kin.link_names):
-        vertices = kin.link_vertices(index)
-        if vertices is None:
-            continue
+    for link in world.kinematics(arm).link_names:
         try:
-            pose = world.state.robot_link_pose(arm, link)
-        except StopIteration:
+            found = world.link_points(arm, link)
+        except StopIteration:  # a link of the robot that the arm's state does not pose
             continue
-        local = (vertices @ quat_to_matrix(pose.q).T + np.asarray(pose.p) - tcp.p) @ tcp.R
+        if found is None:
+            continue
+        local = (found - tcp.p) @ tcp.R
         if float(np.min(np.linalg.norm(local, axis=1))) > HAND_RADIUS:
             continue
         box = _box_surface(local.min(axis=0), local.max(axis=0))
@@ -157,11 +155,6 @@ def _lowest(points: NDArray[np.float64], pieces, beside: float, clear: float) ->
     return best
 
 
-def _turn(angle: float) -> NDArray[np.float64]:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
 def _cavity(world: World, target: str) -> tuple[NDArray[np.float64], float, float]:
     """The cavity's axis point at its floor (world), its radius and its floor height."""
     cavity = world.asset(target).cavity
@@ -191,7 +184,7 @@ def release_pose(world: World, arm: str, obj: str, target: str, clear: float = 0
                              for a in np.linspace(0.0, 2 * np.pi, 8, endpoint=False)]
     options = []
     for k, angle in enumerate(turns):
-        turn = _turn(angle)
+        turn = axis_angle_matrix(UP, angle)
         R = turn @ tcp.R
         off = turn @ centre_off
         h, o = hand @ R.T, held @ R.T

@@ -40,6 +40,12 @@ def required_fraction(world: World, body: str) -> float:
     return _largest(_requirement_conditions(world), "opened", body, "fraction", 0.5)
 
 
+def success_fraction(world: World, body: str) -> float:
+    """The largest ``opened(body, fraction=f)`` the success condition asks for (0 when it
+    does not)."""
+    return _largest([world.monitor.success.condition], "opened", body, "fraction", 0.5)
+
+
 def required_lift(world: World, obj: str) -> float:
     """The largest ``lifted(obj, by=h)`` (m) the success condition or a requirement asks for
     (0 when none does)."""
@@ -149,4 +155,4 @@ def retreat_home(world: World, style: Style, arm: str) -> Plan:
 
 
 __all__ = ["HANDLE_DEPTH", "HAND_BOTTOM", "HAND_HALF_LENGTH", "HAND_HALF_WIDTH", "REACH_SLACK", "place_point", "required_fraction",
-           "required_lift", "retreat_home"]
+           "required_lift", "retreat_home", "success_fraction"]

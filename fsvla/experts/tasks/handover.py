@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.pose import quat_to_matrix, rotation_angle
+from fsvla.compiler.pose import axis_angle_matrix, quat_to_matrix, rotation_angle
 
 from .. import grasps
 from ..motion import Pose, Segment
@@ -104,12 +104,6 @@ def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
         spot = np.array([centre[0], centre[1], 0.0])
     yield from place(world, style, taker, obj, spot)
     yield from retreat_home(world, style, taker)
-
-
-def _turn(angle: float) -> NDArray[np.float64]:
-    """Rotation by ``angle`` (rad) about the vertical."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def _yaw_between(u: NDArray[np.float64], v: NDArray[np.float64]) -> float:
@@ -234,7 +228,7 @@ def _giver_at_meeting(world: World, giver: str, grip: Pose, centre: NDArray[np.f
     """The giver's TCP pose that holds the object (gripped at ``grip`` while its middle is
     at ``centre``) with its middle at ``middle`` and its long axis along ``toward``: the
     hand turned about the vertical."""
-    turn = _turn(_yaw_between(horizontal(centre - grip.p), toward))
+    turn = axis_angle_matrix(UP, _yaw_between(horizontal(centre - grip.p), toward))
     return Pose(middle + turn @ (grip.p - centre), turn @ grip.R)
 
 

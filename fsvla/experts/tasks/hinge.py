@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from fsvla.compiler.pose import axis_angle_matrix
 
-from ..motion import Guard, Pose, Segment
+from ..motion import Pose, Segment
 from ..skills import (
     DOWN,
     FIXED_JAW_CLEARANCE,
@@ -33,13 +33,14 @@ from ..skills import (
     Plan,
     branch_for_path,
     free_speed,
+    grip_guard,
     nearest_arm,
     opening_for,
     transit,
 )
 from ..style import Style
 from ..world import World
-from .lid import _smooth_arc
+from .lid import smooth_arc
 
 #: How far (m) a pinch keeps its fingers' inner edge out from the face the knob or handle
 #: stands on (the fingers are thicker than a knob stands proud).
@@ -347,11 +348,8 @@ def pinch_force(world: World, style: Style, body: str) -> float:
     """The careful squeeze on a part of ``body``: the style's grip force, at most half of a
     contact-force limit on the hand or the body and out of its warning band, at least 2 N."""
     force = float(style.grip_force or 0.0)
-    names = {"gripper", body, *[f"{a}_gripper" for a in world.arm_names]}
-    for channel in world.monitor.channels:
-        if channel.metric == "contact_force" and set(channel.subjects) & names:
-            force = min(force, 0.5 * channel.limit, channel.limit - channel.soft_threshold - 1.0)
-    return max(force, 2.0)
+    allowed = world.force_allowance("gripper", body, *[f"{a}_gripper" for a in world.arm_names])
+    return max(force if allowed is None else min(force, allowed), 2.0)
 
 
 def pinch(world: World, style: Style, arm: str, body: str, width: float) -> Plan:
@@ -365,8 +363,7 @@ def pinch(world: World, style: Style, arm: str, body: str, width: float) -> Plan
         yield Segment(grippers={arm: target}, gripper_steps=style.gripper_steps,
                       settle=style.settle, label="pinch")
         return
-    guard = Guard(arm, force, body, hold_measured=False,
-                  keep_lead=1.0 if world.fingers_slide(arm) else 0.5)
+    guard = grip_guard(world, arm, force, body)
     near = world.opening_fraction(arm, width + 0.006)
     yield Segment(grippers={arm: near}, gripper_steps=style.gripper_steps, label="preclose")
     steps = max(2 * style.gripper_steps, int(np.ceil((near - target) / SLOW_CLOSE)))
@@ -382,8 +379,7 @@ def squeeze_on(world: World, style: Style, arm: str, body: str, force: float,
     closed, as Baxter's, leave a handle loose at the width model's opening)."""
     if not style.avoid_hazards:
         return
-    guard = Guard(arm, force, body, hold_measured=False,
-                  keep_lead=1.0 if world.fingers_slide(arm) else 0.5)
+    guard = grip_guard(world, arm, force, body)
     goal = world.gripper_opening(arm)
     for _ in range(SQUEEZE_STEPS):
         if world.hand_force(arm, body) >= 0.8 * force or goal <= 0.0:
@@ -405,7 +401,7 @@ def _sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose
            start: float, end: float, label: str) -> Plan:
     """Careful: one smooth sweep along the arc; careless: 8° chords at approach speed."""
     if style.avoid_hazards:
-        yield from _smooth_arc(world, style, arm, pose_at, start, end,
+        yield from smooth_arc(world, style, arm, pose_at, start, end,
                                max(style.contact_speed * 4, 0.06), label)
         return
     steps = max(2, int(np.ceil(abs(end - start) / np.deg2rad(8.0))))

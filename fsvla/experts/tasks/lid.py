@@ -75,7 +75,7 @@ def lift_lid(world: World, style: Style, body: str, angle: float) -> Plan:
             last[0] = pose.R
             return pose
 
-        yield from _smooth_arc(world, style, arm, chained_at, now, angle, speed, "lift lid")
+        yield from smooth_arc(world, style, arm, chained_at, now, angle, speed, "lift lid")
     else:
         steps = max(2, int(np.ceil((angle - now) / np.deg2rad(8.0))))
         for theta in np.linspace(now, angle, steps + 1)[1:]:
@@ -99,7 +99,7 @@ def _chained(pose_at: Callable[..., Pose], start: float, end: float, near: np.nd
     return tuple(poses)
 
 
-def _smooth_arc(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose],
+def smooth_arc(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose],
                 start: float, end: float, speed: float, label: str) -> Plan:
     """Follow ``pose_at(theta)`` from ``start`` to ``end`` without stopping: one segment per
     control step, the parameter eased in and out over the whole arc, the peak TCP speed
@@ -115,4 +115,4 @@ def _smooth_arc(world: World, style: Style, arm: str, pose_at: Callable[[float],
         yield Segment({arm: pose_at(float(theta))}, speed=2.0 * speed, label=label)
 
 
-__all__ = ["LID_PAST_VERTICAL", "lift_lid"]
+__all__ = ["LID_PAST_VERTICAL", "lift_lid", "smooth_arc"]

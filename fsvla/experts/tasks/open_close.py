@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 
 from fsvla.compiler.pose import axis_angle_matrix
-from fsvla.dsl.models import predicates_in
 
 from ..motion import ArmDriver, Guard, Pose, Segment
 from ..skills import (
@@ -21,7 +20,7 @@ from ..skills import (
 )
 from ..style import Style
 from ..world import World
-from .common import HAND_HALF_WIDTH, HANDLE_DEPTH, required_fraction
+from .common import HAND_HALF_WIDTH, HANDLE_DEPTH, required_fraction, success_fraction
 from .hinge import (
     has_shape,
     knob_pinch_fits,
@@ -99,12 +98,8 @@ PUSH_FORCE = 25.0
 def push_force(world: World, arm: str, body: str) -> float:
     """What a careful push of ``body`` stops at: PUSH_FORCE, or half of the tightest
     contact-force limit on the hand or the body and out of its warning band, at least 3 N."""
-    hand = {"gripper", f"{arm}_gripper", body}
-    force = PUSH_FORCE
-    for channel in world.monitor.channels:
-        if channel.metric == "contact_force" and set(channel.subjects) & hand:
-            force = min(force, 0.5 * channel.limit, channel.limit - channel.soft_threshold - 1.0)
-    return max(3.0, force)
+    allowed = world.force_allowance("gripper", f"{arm}_gripper", body)
+    return max(3.0, PUSH_FORCE if allowed is None else min(PUSH_FORCE, allowed))
 
 
 def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Plan:
@@ -191,7 +186,7 @@ def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
         else:
             yield from lift_lid(world, style, body, angle)
     elif _handled_door(world, body):
-        asked = max(need, _success_fraction(world, body))
+        asked = max(need, success_fraction(world, body))
         yield from swing_door(world, style, body, min(asked + 0.12, 0.95) * span)
     else:
         raise NotImplementedError(_unsupported(body, part.name, joint.type, "open"))
@@ -219,31 +214,21 @@ def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
 def _sliding(world: World, body: str) -> bool:
     """A prismatic part with a `handle` (a drawer)."""
     part, joint = world.part(body)
-    return joint.type == "prismatic" and _has_shape(world, body, part.link, "handle")
+    return joint.type == "prismatic" and has_shape(world, body, part.link, "handle")
 
 
 def _knob_lid(world: World, body: str) -> bool:
     """A revolute part with a `knob` and a `panel` (a lid hinged along one edge)."""
     part, joint = world.part(body)
-    return (joint.type == "revolute" and _has_shape(world, body, part.link, "knob")
-            and _has_shape(world, body, part.link, "panel"))
+    return (joint.type == "revolute" and has_shape(world, body, part.link, "knob")
+            and has_shape(world, body, part.link, "panel"))
 
 
 def _handled_door(world: World, body: str) -> bool:
     """A revolute part with a `handle` and a `panel` (a door on a hinge)."""
     part, joint = world.part(body)
-    return (joint.type == "revolute" and _has_shape(world, body, part.link, "handle")
-            and _has_shape(world, body, part.link, "panel"))
-
-
-_has_shape = has_shape
-
-
-def _success_fraction(world: World, body: str) -> float:
-    """The largest ``opened(body, fraction=f)`` the success condition asks for (0: none)."""
-    return max([0.0, *(float(p.params.get("fraction", 0.5))
-                       for p in predicates_in(world.monitor.success.condition)
-                       if p.name == "opened" and p.args[0] == body)])
+    return (joint.type == "revolute" and has_shape(world, body, part.link, "handle")
+            and has_shape(world, body, part.link, "panel"))
 
 
 def _unsupported(body: str, part: str, joint: str, verb: str) -> str:

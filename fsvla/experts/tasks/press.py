@@ -30,12 +30,8 @@ def press_force(world: World, arm: str, obj: str) -> float:
     """The force the careful expert presses ``obj`` with: PRESS_FORCE, or less where a
     contact-force limit watches the object or the hand: half the limit, and out of its
     warning band."""
-    hand = {"gripper", f"{arm}_gripper", obj}
-    force = PRESS_FORCE
-    for channel in world.monitor.channels:
-        if channel.metric == "contact_force" and set(channel.subjects) & hand:
-            force = min(force, 0.5 * channel.limit, channel.limit - channel.soft_threshold - 1.0)
-    return max(LEAST_PRESS, force)
+    allowed = world.force_allowance("gripper", f"{arm}_gripper", obj)
+    return max(LEAST_PRESS, PRESS_FORCE if allowed is None else min(PRESS_FORCE, allowed))
 
 
 def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
