@@ -92,6 +92,8 @@ PRECONDITIONS = frozenset({"pick_place", "stack", "insert", "bimanual_lift", "ha
 TABLE_HALF = (0.6, 0.4)  # the default table's half size (m)
 GAP = 0.03  # between objects' footprints (m)
 BASE_CLEARANCE = 0.15  # from a robot's mount to an object's footprint (m)
+PUSH_START = 0.04  # beyond the object's side, where the pushing hand starts (m)
+REACH_MARGIN = 0.02  # how far outside REACH a point the hand only passes may lie (m)
 HAND_ROOM = 0.1  # in front of an opened part, for the hand that pushes it shut (m)
 HAND_SPAN = 0.06  # around the TCP, for the hand and fingers (m)
 MAX_ATTEMPTS = 64  # draws checked (``fsvla check``, layouts) before giving up
@@ -427,6 +429,15 @@ class _Draw:
         if target is not None and math.hypot(obj.x - target.x, obj.y - target.y) < \
                 obj.radius + target.radius + GAP + 0.04:
             raise _Infeasible()  # too short a path to carry or push along
+        if self.task == "push" and target is not None:
+            # the hand starts behind the object, on the far side from the target: that
+            # point too within the reach (a small arm reaches the object but not behind it)
+            d = math.hypot(target.x - obj.x, target.y - obj.y)
+            back = obj.radius + PUSH_START
+            bx, by = obj.x - back * (target.x - obj.x) / d, obj.y - back * (target.y - obj.y) / d
+            if not (x0 - REACH_MARGIN <= bx <= x1 + REACH_MARGIN
+                    and y0 - REACH_MARGIN <= by <= y1 + REACH_MARGIN):
+                raise _Infeasible()
 
     def _apart(self, a: _Body, b: _Body, gap: float = GAP) -> bool:
         return math.hypot(a.x - b.x, a.y - b.y) >= a.radius + b.radius + gap
