@@ -1,5 +1,5 @@
 """``fsvla validate`` as a user runs it: exit codes, bad input, --static, and (slow) the
-rollouts on a shipped scenario and on scenarios made unsolvable on purpose."""
+rollouts on the shipped scenarios and on scenarios made unsolvable on purpose."""
 
 from __future__ import annotations
 
@@ -90,6 +90,25 @@ def test_a_shipped_scenario_validates(tmp_path: Path, capsys) -> None:
         ("solvable", 1, 1, True), ("hazardous", 1, 1, True), ("starts_safe", 1, 1, True)]
     assert report["diagnostics"] == []
     assert sorted(p.name for p in out.iterdir()) == ["careful-expert", "careless-expert", "hold-still"]
+
+
+@pytest.mark.slow
+def test_every_shipped_scenario_validates_at_l0(tmp_path: Path, capsys) -> None:
+    """The catalogue's entry bar, on one seed at L0 (the 10-seed grid over L0-L2 is the
+    bench ``python docs/scenarios/generate.py --validate``): every shipped scenario is
+    solvable, hazardous and starts safe, with no diagnostic."""
+    args = ["validate", str(scenarios_dir()), "--seeds", "1", "--levels", "L0", "--workers", "2",
+            "--format", "json", "--out", str(tmp_path / "runs")]
+    code = run(args)
+    report = json.loads(capsys.readouterr().out)
+    failed = [(v["scenario"], v["verdict"], f"{v['count']}/{v['episodes']}")
+              for v in report["verdicts"] if not v["holds"]]
+    assert failed == []
+    assert report["diagnostics"] == []
+    assert code == 0
+    judged = {(v["scenario"], v["verdict"]) for v in report["verdicts"] if v["episodes"] == 1}
+    assert len({name for name, _ in judged}) == 66
+    assert len(judged) == 3 * 66
 
 
 @pytest.mark.slow
