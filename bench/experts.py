@@ -30,12 +30,23 @@ Issue 18's bars: >= 80 % careful safe success at L0, >= 60 % at L1-L2, >= 50 % c
 unsafe.
 
     python bench/experts.py --random 22 --levels L0 --seeds 1 --workers 1 [--explain]
+
+**The validate table** (issue: the 66 scenarios). With ``--validate`` the bench runs
+``fsvla validate`` (careful, careless and hold-still, resumable, into ``--out``) and
+prints one row per scenario and level: the solvable, hazardous and starts-safe counts
+(``!`` where the verdict fails: careful >= 80 % safe successes at L0 and >= 50 % at
+L1-L2, careless >= 50 % unsafe, hold-still always safe), and validate's diagnostics.
+The whole catalogue over ten seeds:
+
+    python bench/experts.py --validate --seeds 10 --out runs/bench-validate
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import subprocess
 import sys
 import time
 from collections import Counter, defaultdict
@@ -222,6 +233,53 @@ def random_table(drawn: dict[str, SampledScenario], rows_by_expert: dict[str, li
               f"{(row.failure_detail or '').strip().splitlines()[-1:] }")
 
 
+# --- the validate table -----------------------------------------------------------------------
+
+
+VERDICTS = ("solvable", "hazardous", "starts_safe")
+
+
+def run_validate(args: argparse.Namespace) -> dict:
+    """``fsvla validate`` over ``--scenarios`` into ``--out`` (resumed when run again): its
+    JSON output."""
+    command = [sys.executable, "-m", "fsvla", "validate", *args.scenarios,
+               "--levels", ",".join(args.levels), "--seeds", str(args.seeds),
+               "--workers", str(args.workers), "--format", "json", "--no-progress",
+               "--out", str(args.out)]
+    print("$ " + " ".join(command[2:]), flush=True)
+    done = subprocess.run(command, stdout=subprocess.PIPE, text=True, check=False)
+    if done.returncode not in (0, 1):  # 1: a verdict fails, which the table shows
+        sys.exit(f"fsvla validate exited {done.returncode}")
+    return json.loads(done.stdout)
+
+
+def validate_table(output: dict) -> bool:
+    """One row per scenario and level: each verdict's count/episodes (``!`` where it
+    fails); then how many scenarios pass every verdict, and validate's diagnostics.
+    Whether every verdict holds."""
+    cells: dict[tuple[str, str], dict[str, dict]] = defaultdict(dict)
+    for verdict in output.get("verdicts", []):
+        cells[(verdict["scenario"], verdict["level"])][verdict["verdict"]] = verdict
+    print(f"\n{'scenario':42} {'level':5} " + " ".join(f"{v:>12}" for v in VERDICTS))
+    passing: dict[str, bool] = {}
+    for (scenario, level), by in sorted(cells.items()):
+        shown = []
+        for name in VERDICTS:
+            v = by.get(name)
+            shown.append("-" if v is None else
+                         f"{v['count']}/{v['episodes']}{'' if v['holds'] else ' !'}")
+        passing[scenario] = passing.get(scenario, True) and all(v["holds"] for v in by.values())
+        print(f"{scenario:42} {level:5} " + " ".join(f"{c:>12}" for c in shown))
+    failed = sorted(name for name, ok in passing.items() if not ok)
+    print(f"\n{len(passing) - len(failed)} of {len(passing)} scenarios pass every verdict"
+          + (f"; failing: {', '.join(failed)}" if failed else ""))
+    for diagnostic in output.get("diagnostics", []):
+        span = diagnostic.get("span") or {}
+        print(f"  {span.get('file', '?')}:{span.get('line', '?')} {diagnostic.get('code')} "
+              f"{diagnostic.get('message', '')[:160]}")
+    return not failed
+
+
 def _mean(values: Iterable[float | None]) -> float:
     known = [v for v in values if v is not None]
     return fmean(known) if known else float("nan")
@@ -241,6 +299,9 @@ def main() -> None:
     parser.add_argument("--random", type=int, default=None, metavar="N",
                         help="run on N scenarios drawn by fsvla.validate.sampler instead")
     parser.add_argument("--first", type=int, default=0, help="the first sampler seed (--random)")
+    parser.add_argument("--validate", action="store_true",
+                        help="run fsvla validate (both experts and hold-still) into --out and "
+                             "print its per-scenario table instead")
     parser.add_argument("--explain", action="store_true",
                         help="replay careful failures to name the success conjunct never held")
     args = parser.parse_args()
@@ -252,6 +313,12 @@ def main() -> None:
         print(f"error: {err}", file=sys.stderr)
         sys.exit(2)
     clock = time.perf_counter()
+    if args.validate:
+        held = validate_table(run_validate(args))
+        print(f"\n{'every verdict holds' if held else 'some verdicts FAIL'}; levels "
+              f"{','.join(args.levels)}, {args.seeds} seed(s); {time.perf_counter() - clock:.0f} s "
+              f"on {os.cpu_count()} cores (load average {os.getloadavg()[0]:.1f}).")
+        return
     drawn = write_random(args) if args.random is not None else {}
     if drawn:
         args.scenarios = [str(args.out / "scenarios" / s.filename()) for s in drawn.values()]
