@@ -100,7 +100,8 @@ class ExpertPolicy:
         if task.name not in BIMANUAL_TASKS and len(world.arm_names) > 1:
             # one arm works: the other first moves out of its way (where arms are kept apart)
             active = nearest_arm(world, world.body_pose(task.roles["object"]).p)
-            plan = chain(park_others(world, self.style, active), plan)
+            work = tuple(world.body_pose(body).p for body in task.roles.values())
+            plan = chain(park_others(world, self.style, active, work), plan)
         self._plan = plan
         self._queue.clear()
         self._last = None

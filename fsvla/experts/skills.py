@@ -313,11 +313,15 @@ PARK_OUT = 0.2
 PARK_UP = 0.08
 
 
-def park_others(world: World, style: Style, arm: str) -> Plan:
+def park_others(world: World, style: Style, arm: str,
+                work: tuple[NDArray[np.float64], ...] = ()) -> Plan:
     """Careful, on a robot whose arms a ``separation`` limit keeps apart: move every other
-    arm's hand away from ``arm`` (along the line between their bases, out of the way of
-    the arm about to work) and up by PARK_UP, as far as PARK_OUT that it reaches.
-    Baxter's idle arm stands right beside the other's work at home."""
+    arm's hand out of the way of ``arm`` and up by PARK_UP, as far as PARK_OUT that it
+    reaches. Out of the way: along the line between their bases, or, where ``work`` (the
+    points the working arm goes to: the task's objects) is given, whichever of that line,
+    back toward its own base or both together leaves its hand farthest from them (the
+    working arm may carry to the idle arm's side of the table). Baxter's idle arm stands
+    right beside the other's work at home."""
     if not style.avoid_hazards or len(world.arm_names) < 2 or not any(
             c.metric == "separation" for c in world.monitor.channels):
         return
@@ -327,11 +331,22 @@ def park_others(world: World, style: Style, arm: str) -> Plan:
             continue
         away = horizontal(world.base_position(other) - world.base_position(arm))
         now = world.current_pose(other)
-        for out in (PARK_OUT, 0.6 * PARK_OUT, 0.3 * PARK_OUT):
-            pose = now.moved(out * away + PARK_UP * UP)
-            if branch_for_path(world, other, (now, pose)) is not None:
-                targets[other] = pose
+        ways = [away]
+        if work:
+            back = horizontal(world.base_position(other) - now.p)
+            ways += [back, horizontal(away + back)]
+        best: tuple[float, Pose] | None = None
+        for way in ways:
+            for out in (PARK_OUT, 0.6 * PARK_OUT, 0.3 * PARK_OUT):
+                pose = now.moved(out * way + PARK_UP * UP)
+                if branch_for_path(world, other, (now, pose)) is None:
+                    continue
+                room = min((float(np.linalg.norm((pose.p - p)[:2])) for p in work), default=0.0)
+                if best is None or room > best[0] + 0.01:
+                    best = (room, pose)
                 break
+        if best is not None:
+            targets[other] = best[1]
     if targets:
         yield Segment(targets, speed=free_speed(style), label="park")
 
