@@ -173,14 +173,25 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float)
     return h, arm, R, local, centre, width, beyond, path(R, local)
 
 
-def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
+def swing_lid(world: World, style: Style, body: str, angle: float,
+              least: float | None = None) -> Plan:
     """Pinch a lid's knob by its ends (the fingers closing along the hinge) and carry it
     along its arc to ``angle`` (rad), the hand turning with the lid; let go and rise.
     The hand's turn on the lid is the one that keeps it nearest pointing down over the
     whole arc (tilted toward the robot at one end, away at the other), its fingers clear
     of the lid's edge behind the knob. Opening: past upright, the lid falls open onto its
-    stop. Closing: pulled over upright and lowered onto its seat, not dropped."""
-    grip = _lid_grip(world, style, body, hinge(world, body).now, angle)
+    stop. Closing: pulled over upright and lowered onto its seat, not dropped.
+    Opening where no IK branch follows the arc to ``angle``: carried as far as one does,
+    but at least to ``least`` (rad), and held there, since it would fall shut."""
+    now = hinge(world, body).now
+    grip = _lid_grip(world, style, body, now, angle)
+    held = False
+    if grip is None and least is not None and now < least < angle:
+        for lower in np.linspace(angle, least, 5)[1:]:
+            grip = _lid_grip(world, style, body, now, float(lower))
+            if grip is not None:
+                angle, held = float(lower), True
+                break
     if grip is None:
         raise NotImplementedError(_out_of_reach(nearest_arm(world, world.body_pose(body).p),
                                                 body, "knob", hinge(world, body).now, angle))
@@ -194,6 +205,9 @@ def swing_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     yield from pinch(world, style, arm, body, width)
     yield from _sweep(world, style, arm, lambda t: _lid_pose(h, R, local, centre, t),
                       h.now, angle, "swing lid")
+    if held:  # short of upright: let go and it falls shut
+        yield Segment({}, settle=round(world.scenario.horizon / world.dt), label="hold lid open")
+        return
     yield Segment({}, settle=style.settle, label="hold lid")
     yield from _let_go(world, style, arm, opening, 0.05)
 

@@ -182,7 +182,8 @@ def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
     elif _knob_lid(world, body):
         angle = min(max(LID_PAST_VERTICAL, (need + 0.07) * span), 0.95 * span)
         if knob_pinch_fits(world, body):
-            yield from swing_lid(world, style, body, angle)
+            least = min((max(need, success_fraction(world, body)) + 0.07) * span, angle)
+            yield from swing_lid(world, style, body, angle, least)
         else:
             yield from lift_lid(world, style, body, angle)
     elif _handled_door(world, body):
