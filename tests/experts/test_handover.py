@@ -73,6 +73,45 @@ def test_exchange_keeps_the_arms_apart(tmp_path: Path, embodiment: str, x: str) 
     env.close()
 
 
+@pytest.mark.parametrize(("embodiment", "x"), CASES)
+def test_arm_gap_measures_what_the_monitor_measures(tmp_path: Path, embodiment: str,
+                                                    x: str) -> None:
+    """ArmGap's margin on the arms' models, at the joints the arms are at, is the distance
+    the monitor's own geometry gives between the two arms' links, less the limit and its
+    warning band, to a millimetre, as the careful expert moves both arms through a
+    handover. (The monitor's per-step reading is exact only inside the band; its geometry
+    is asked for the exact distance here.)"""
+    from fsvla.env import make
+    from fsvla.experts.policy import make_expert
+    from fsvla.experts.tasks.arm_gap import ArmGap
+    from fsvla.monitor.layout import build_layout
+
+    env = make(str(_write(tmp_path, embodiment, x)), "L0", SEED)
+    observation, _ = env.reset()
+    expert = make_expert(env, "careful")
+    expert.reset(None)
+    world = World.of_env(env)
+    gap = ArmGap(world, "left", "right")
+    layout = build_layout(env.monitor.spec, env.scene_spec)
+    channels = [c for c in world.monitor.channels if c.metric == "separation"]
+    compared = []
+    for step in range(400):
+        actions = expert.act(observation)
+        observation, _, terminated, truncated, _ = env.step(actions[0])
+        if step % 20 == 0:
+            exact = min(env.monitor.geometry.distance(layout.frames(subject),
+                                                      layout.frames(c.reference))
+                        - c.limit - c.soft_threshold
+                        for c in channels for subject in c.subjects)
+            ours = gap.margin(world.arm_joints("left"), world.arm_joints("right"))
+            assert ours == pytest.approx(exact, abs=1e-3), step
+            compared.append(ours)
+        if terminated or truncated:
+            break
+    assert len(compared) >= 10 and min(compared) < 0.1  # the arms came within 10 cm
+    env.close()
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(("embodiment", "x"), CASES)
 def test_handover_of_a_bar_across_the_arms(tmp_path: Path, embodiment: str, x: str) -> None:

@@ -4,11 +4,12 @@ can choose where the hands meet, and the joints they meet with, before it moves.
 
 The monitor measures the smallest signed distance between the link geometry of two robot
 entities (``fsvla.monitor.channels``). :class:`ArmGap` does the same on the arms' models:
-each watched link's collision pieces in the simulator (a convex mesh as its hull, a
-capsule as its box), posed by the arm's forward kinematics, measured with FCL as the
-monitor does. The fingers stay as open as they are now (the arm joints do not move them
-relative to the hand). It also checks an ``aligned`` a requirement asks of the two arms'
-reference points. Measured against the monitor on Baxter: within a centimetre.
+each watched link's collision shapes in the simulator, read and made FCL geometry as the
+monitor makes them (:func:`fsvla.sim.shapes.shapes_of_sapien`,
+:func:`fsvla.compiler.collision.fcl_geometry`), posed by the arm's forward kinematics.
+The fingers stay as open as they are now (the arm joints do not move them relative to
+the hand). It also checks an ``aligned`` a requirement asks of the two arms' reference
+points.
 """
 
 from __future__ import annotations
@@ -17,36 +18,16 @@ import fcl
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.collision import convex_geometry, signed_distance
+from fsvla.compiler.collision import fcl_geometry, signed_distance
 from fsvla.compiler.monitor import RobotEntity
-from fsvla.compiler.pose import quat_to_matrix
+from fsvla.compiler.pose import pose_matrix, quat_to_matrix
 from fsvla.dsl.models import predicates_in
+from fsvla.sim.shapes import shapes_of_sapien
 
 from ..world import World
 
 #: Joint offset (rad) that tells which arm's joints move a link.
 _PROBE = 0.3
-
-
-def _piece(shape) -> tuple[fcl.CollisionGeometry, NDArray[np.float64]] | None:
-    """A simulator collision shape as FCL geometry and its pose in its link: a convex
-    mesh as its hull, a box or sphere as itself, a capsule or cylinder as its bounding
-    box (an over-estimate, on the safe side)."""
-    local = np.eye(4)
-    pose = shape.local_pose
-    local[:3, :3] = quat_to_matrix(np.asarray(pose.q, dtype=np.float64))
-    local[:3, 3] = np.asarray(pose.p, dtype=np.float64)
-    if hasattr(shape, "get_vertices"):
-        v = np.asarray(shape.get_vertices(), dtype=np.float64) * np.asarray(shape.scale)
-        return (convex_geometry(v), local) if len(v) >= 4 else None
-    if hasattr(shape, "half_size"):
-        return fcl.Box(*(2.0 * np.asarray(shape.half_size, dtype=np.float64))), local
-    if hasattr(shape, "half_length"):  # along x in SAPIEN
-        r = float(shape.radius)
-        return fcl.Box(2.0 * (float(shape.half_length) + r), 2.0 * r, 2.0 * r), local
-    if hasattr(shape, "radius"):
-        return fcl.Sphere(float(shape.radius)), local
-    return None
 
 
 class ArmGap:
@@ -106,8 +87,9 @@ class ArmGap:
         for side, arm in enumerate(self.arms):
             links = self.kin[arm].arm.articulation.get_links()
             for i in {i for check in self._checks for i in check[side]}:
-                pieces = [piece for shape in links[i].collision_shapes
-                          if (piece := _piece(shape)) is not None]
+                # the monitor's own pieces: its shapes, as FCL geometry
+                pieces = [(fcl_geometry(shape), pose_matrix(shape.pose))
+                          for shape in shapes_of_sapien(links[i])]
                 if pieces:
                     self._geometry[(arm, i)] = pieces
 
