@@ -107,6 +107,18 @@ def test_careful_expert_opens_a_low_lid(tmp_path: Path) -> None:
     assert result.safe_success, result.summary()
 
 
+@pytest.mark.slow
+def test_a_lid_the_arm_cannot_carry_past_upright_is_held_open(tmp_path: Path) -> None:
+    """A 19 cm box close to the Panda's base: no IK branch follows the knob past upright,
+    but one follows it past the 60 % the success asks: opened that far and held there,
+    a safe success (it was an out-of-reach error)."""
+    path = _write(tmp_path, LID.replace("(18 cm, 14 cm, 9 cm)", "(19.1 cm, 13.2 cm, 9.3 cm)").format(
+        task="open", embodiment="panda", open="", at="(6.5 cm, 3.2 cm)",
+        success="opened(box, fraction=0.6)"))
+    result = rollout(str(path), "careful", "L0", 1731914883)
+    assert result.safe_success, result.summary()
+
+
 DOOR = """\
 scenario close_door
   suite force
