@@ -4,8 +4,8 @@ can choose where the hands meet, and the joints they meet with, before it moves.
 
 The monitor measures the smallest signed distance between the link geometry of two robot
 entities (``fsvla.monitor.channels``). :class:`ArmGap` does the same on the arms' models:
-each watched link's collision shapes in the simulator, read and made FCL geometry as the
-monitor makes them (:func:`fsvla.sim.shapes.shapes_of_sapien`,
+each watched link's collision shapes, read from the scene and made FCL geometry as the
+monitor reads and makes them (``MonitoredScene.frame_shapes``,
 :func:`fsvla.compiler.collision.fcl_geometry`), posed by the arm's forward kinematics.
 The fingers stay as open as they are now (the arm joints do not move them relative to
 the hand). It also checks an ``aligned`` a requirement asks of the two arms' reference
@@ -22,7 +22,7 @@ from fsvla.compiler.collision import fcl_geometry, signed_distance
 from fsvla.compiler.monitor import RobotEntity
 from fsvla.compiler.pose import pose_matrix, quat_to_matrix
 from fsvla.dsl.models import predicates_in
-from fsvla.sim.shapes import shapes_of_sapien
+from fsvla.monitor.state import robot_frame
 
 from ..world import World
 
@@ -85,11 +85,11 @@ class ArmGap:
                 ia, ib = (x[1], y[1]) if x[0] == a else (y[1], x[1])
                 self._aligned.append((ia, ib, float(p.params.get("within", 0.05))))
         for side, arm in enumerate(self.arms):
-            links = self.kin[arm].arm.articulation.get_links()
+            names = self.kin[arm].link_names
             for i in {i for check in self._checks for i in check[side]}:
-                # the monitor's own pieces: its shapes, as FCL geometry
-                pieces = [(fcl_geometry(shape), pose_matrix(shape.pose))
-                          for shape in shapes_of_sapien(links[i])]
+                # the monitor's own pieces: the scene's shapes of the link, as FCL geometry
+                shapes = world.state.frame_shapes(robot_frame(robot_of[arm], names[i]))
+                pieces = [(fcl_geometry(shape), pose_matrix(shape.pose)) for shape in shapes]
                 if pieces:
                     self._geometry[(arm, i)] = pieces
 
