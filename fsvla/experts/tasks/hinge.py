@@ -194,7 +194,7 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
                 break
     if grip is None:
         raise NotImplementedError(_out_of_reach(nearest_arm(world, world.body_pose(body).p),
-                                                body, "knob", hinge(world, body).now, angle))
+                                                body, "knob", now, angle))
     h, arm, R, local, centre, width, beyond, arc = grip
     start = _lid_pose(h, R, local, centre, h.now)
     back = start.moved(beyond)
