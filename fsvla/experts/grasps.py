@@ -215,7 +215,7 @@ def handle_grasp(world: World, arm: str, obj: str, handle: str, pitch: float = 0
 
 #: Pitches (deg) tried for a handle grasp, the flattest first: a handle low and close to
 #: the arm's base has no comfortable horizontal reach (the elbow folds onto its limit;
-#: lift_pot_close_arms at L1 needs 40 deg).
+#: a pot's handles close to the bases of two arms on a narrow table need 40 deg).
 HANDLE_PITCHES = (0.0, 15.0, 30.0, 40.0, 50.0, 60.0)
 
 
