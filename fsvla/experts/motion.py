@@ -90,7 +90,9 @@ class Segment:
     # branch that also reaches these poses (the grasp below a hover point)
     joints: dict[str, NDArray[np.float64]] = field(default_factory=dict)  # joint_space: the
     # end joints the plan chose (a branch that follows a path after it), instead of IK
-    guard: Guard | None = None  # move until this force is felt (checked every step)
+    #: move until these forces are felt (checked every step); an arm whose guard is felt
+    #: stops, the others go on until theirs are (two hands closing on one pot together)
+    guards: tuple[Guard, ...] = ()
 
 
 class ArmDriver:
@@ -338,7 +340,7 @@ class Step:
     pose: dict[str, Pose]
     gripper: dict[str, float]
     label: str = ""
-    guard: Guard | None = None  # read the hand's force before this step; stop if felt
+    guards: tuple[Guard, ...] = ()  # read the hands' forces before this step; stop if felt
 
 
 def expand(segment: Segment, drivers: Mapping[str, ArmDriver], dt: float,
@@ -389,8 +391,8 @@ def expand(segment: Segment, drivers: Mapping[str, ArmDriver], dt: float,
             for name, g in segment.grippers.items():
                 drivers[name].gripper = starts_g[name] + (g - starts_g[name]) * i / k
             steps.append(_snapshot(drivers, segment.label))
-    if segment.guard is not None:
-        steps = [replace(step, guard=segment.guard) for step in steps]
+    if segment.guards:
+        steps = [replace(step, guards=segment.guards) for step in steps]
     for _ in range(segment.settle):
         steps.append(_snapshot(drivers, segment.label))
     return steps

@@ -29,7 +29,7 @@ from fsvla.compiler.pose import quat_to_matrix
 from fsvla.dsl.catalog import BIMANUAL_TASKS
 
 from .clearance import ArmClearance
-from .motion import ArmDriver, Pose, Segment, Step, expand
+from .motion import ArmDriver, Guard, Pose, Segment, Step, expand
 from .skills import nearest_arm, park_others
 from .style import CAREFUL, CARELESS, STYLES, Style
 from .tasks import TASK_PLANS
@@ -116,15 +116,16 @@ class ExpertPolicy:
         # the next segment is made only once the last one has run
         while len(steps) < self.chunk and (self._queue or (not steps and self._next_segment())):
             step = self._queue[0]
-            if step.guard is None:
+            if not step.guards:
                 steps.append(self._queue.popleft())
                 continue
-            # a guarded step: the hand's force is read before it, so it ends the chunk
+            # a guarded step: the hands' forces are read before it, so it ends the chunk
             if steps:
                 break
-            guard = step.guard
-            if self._world.hand_force(guard.arm, guard.other) >= guard.force:
-                self._stop_guarded()
+            felt = [g for g in step.guards
+                    if self._world.hand_force(g.arm, g.other) >= g.force]
+            if felt:
+                self._stop_guarded(felt)
                 continue
             steps.append(self._queue.popleft())
             break
@@ -146,35 +147,56 @@ class ExpertPolicy:
                                       self.style.angular_speed))
         return bool(self._queue)
 
-    def _stop_guarded(self) -> None:
-        """A guard felt its force: drop the rest of the guarded motion, and hold the last
-        command through the segment's settle steps (the drivers go back to it, so the plan
-        goes on from where the hand stopped)."""
-        guard = self._queue[0].guard
-        while self._queue and self._queue[0].guard is not None:
-            self._queue.popleft()
-        hold = self._last if self._last is not None else self._measured()
-        if guard is not None and not guard.hold_measured:
-            # a grip: the fingers where they are plus that fraction of the command's lead
-            # (a soft finger drive's lead is its squeeze: a jaw that swung on past the
-            # felt force would keep squeezing with all of it)
-            arm, opening = guard.arm, self._world.gripper_opening(guard.arm)
-            grip = opening + guard.keep_lead * (hold.gripper[arm] - opening)
-            hold = replace(hold, gripper={**hold.gripper, arm: grip})
-        elif guard is not None:
-            # the guarded arm where it is, not where it was told to be: the command leads
-            # the arm, and holding it would push on as the arm catches up
-            arm, measured = guard.arm, self._measured()
-            q = measured.q[arm] + guard.keep_lead * (hold.q[arm] - measured.q[arm])
-            tcp = self._drivers[arm].kin.tcp_pose(q)
-            hold = replace(hold, q={**hold.q, arm: q},
-                           pose={**hold.pose, arm: Pose.of(tcp.p, quat_to_matrix(tcp.q))})
-        self._queue = deque(replace(hold, label=s.label, guard=None) for s in self._queue)
+    def _stop_guarded(self, felt: list[Guard]) -> None:
+        """Guards felt their forces: their arms stop and hold (:meth:`_held`). Once every
+        guard of the motion has been felt, the rest of the guarded motion is dropped and
+        the arms hold through the segment's settle steps; until then the arms whose guards
+        were not felt go on (two hands closing on one pot together). The drivers go back
+        to the held command, so the plan goes on from where the hands stopped."""
+        last = self._last if self._last is not None else self._measured()
+        stopped = {g.arm for g in felt}
+        held = {g.arm: self._held(g, last) for g in felt}
+        if all(g.arm in stopped for g in self._queue[0].guards):
+            while self._queue and self._queue[0].guards:
+                self._queue.popleft()
+            hold = last
+            for arm, (q, pose, grip) in held.items():
+                hold = replace(hold, q={**hold.q, arm: q}, pose={**hold.pose, arm: pose},
+                               gripper={**hold.gripper, arm: grip})
+            self._queue = deque(replace(hold, label=s.label, guards=()) for s in self._queue)
+            commands = hold
+        else:
+            def holding(step: Step) -> Step:
+                q, pose, grip = dict(step.q), dict(step.pose), dict(step.gripper)
+                for arm, (arm_q, arm_pose, arm_grip) in held.items():
+                    q[arm], pose[arm], grip[arm] = arm_q, arm_pose, arm_grip
+                return replace(step, q=q, pose=pose, gripper=grip,
+                               guards=tuple(g for g in step.guards if g.arm not in stopped))
+            self._queue = deque(holding(s) for s in self._queue)
+            commands = self._queue[-1] if self._queue else last
         for name, driver in self._drivers.items():
-            driver.q = hold.q[name].copy()
-            driver.pose = hold.pose[name]
-            driver.gripper = hold.gripper[name]
+            driver.q = commands.q[name].copy()
+            driver.pose = commands.pose[name]
+            driver.gripper = commands.gripper[name]
         self.log.append("stopped by force")
+
+    def _held(self, guard: Guard, last: Step) -> tuple[np.ndarray, Pose, float]:
+        """The command that holds ``guard``'s arm once its force is felt (joints, TCP pose,
+        gripper), from the ``last`` command sent. A grip: the fingers where they are plus
+        the guard's fraction of the command's lead (a soft finger drive's lead is its
+        squeeze: a jaw that swung on past the felt force would keep squeezing with all of
+        it). A move: the arm where it is plus that fraction of the lead, not where it was
+        told to be (the command leads the arm, and holding it would push on as the arm
+        catches up)."""
+        arm = guard.arm
+        if not guard.hold_measured:
+            opening = self._world.gripper_opening(arm)
+            grip = opening + guard.keep_lead * (last.gripper[arm] - opening)
+            return last.q[arm], last.pose[arm], grip
+        measured = self._measured()
+        q = measured.q[arm] + guard.keep_lead * (last.q[arm] - measured.q[arm])
+        tcp = self._drivers[arm].kin.tcp_pose(q)
+        return q, Pose.of(tcp.p, quat_to_matrix(tcp.q)), last.gripper[arm]
 
     def _measured(self) -> Step:
         """A command to hold the arms where they are now."""

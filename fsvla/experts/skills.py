@@ -9,7 +9,7 @@ keep-out distances only in the careful style) before it moves sideways.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from itertools import pairwise
 
@@ -222,13 +222,25 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
         height = low
     # a small arm (an SO-101 reaches 9 cm above the table) crosses as high as it reaches
     height = min(height, max(goal.p[2], reach_ceiling(world, arm, goal.p, goal.R, height)))
+    over = Pose(np.array([goal.p[0], goal.p[1], height]), goal.R)
+    q = branch_for_path(world, arm, (over, goal, *follow)) if follow else None
+    if follow and q is None:
+        # no branch follows the whole line down from this high and on along ``follow`` (a
+        # long descent drives a wrist onto its limit): cross lower, as high as one does,
+        # and no lower than the obstacles need
+        low = max(clear_height(world, style, a.p, goal.p, below, exclude, keep_height=False,
+                               around=around), goal.p[2] + 0.05)
+        for z in np.linspace(height, low, 6)[1:]:
+            lower = Pose(np.array([goal.p[0], goal.p[1], z]), goal.R)
+            q = branch_for_path(world, arm, (lower, goal, *follow))
+            if q is not None:
+                height, over = float(z), lower
+                break
     # careless: a diagonal line to above the goal unless a task object is in the way
     direct = not style.avoid_hazards and clear <= max(a.p[2], goal.p[2]) + 1e-3
     if height > a.p[2] + 1e-3 and not direct:
         yield Segment({arm: Pose(np.array([a.p[0], a.p[1], height]), a.R)},
                       speed=style.transit_speed, label="up")
-    over = Pose(np.array([goal.p[0], goal.p[1], height]), goal.R)
-    q = branch_for_path(world, arm, (over, goal, *follow)) if follow else None
     yield Segment({arm: over}, speed=style.transit_speed, label="across", joint_space=True,
                   branch_of={arm: then if then is not None else goal},
                   joints={arm: q} if q is not None else {})
@@ -419,53 +431,70 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
 
 def close_on(world: World, style: Style, arm: str, obj: str, width: float,
              weight_factor: float = 2.0) -> Plan:
-    """Close the gripper on ``obj`` (``width`` across the fingers): careful with a fragile
-    (force-watched) object, quickly to just short of contact and then slowly to the squeeze
-    of its grip force; otherwise at the style's gripper pace."""
-    held = grip_force(world, obj, style, weight_factor, grasp_lever(world, arm, obj),
-                      grasp_tip(world, arm, obj))
-    target = opening_for(world, arm, width, held)
+    """Close ``arm``'s gripper on ``obj`` (``width`` across the fingers); see
+    :func:`close_hands_on`."""
+    yield from close_hands_on(world, style, {arm: width}, obj, weight_factor)
+
+
+def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj: str,
+                   weight_factor: float = 2.0) -> Plan:
+    """Close the grippers of the arms in ``widths`` (arm -> width across its fingers) on
+    ``obj``, together: careful with a fragile (force-watched) object, quickly to just short
+    of contact and then slowly to the squeeze of its grip force; otherwise at the style's
+    gripper pace. Each hand stops at its own felt squeeze while the others close on."""
+    held = {arm: grip_force(world, obj, style, weight_factor, grasp_lever(world, arm, obj),
+                            grasp_tip(world, arm, obj)) for arm in widths}
+    target = {arm: opening_for(world, arm, widths[arm], held[arm]) for arm in widths}
     if not style.avoid_hazards:
-        yield Segment(grippers={arm: target}, gripper_steps=style.gripper_steps,
+        yield Segment(grippers=target, gripper_steps=style.gripper_steps,
                       settle=style.settle, label="close")
         return
     # careful: the fingers' squeeze is felt as they close (a force-sensing gripper), so a
     # width model that is off (a jaw that swings, fingers that do not meet when closed)
     # neither crushes the object nor leaves it loose
-    force = float(held.grip_force or 0.0)
-    guard = grip_guard(world, arm, force, obj)
-    if force_watched(world, obj) or not world.fingers_slide(arm):
+    force = {arm: float(held[arm].grip_force or 0.0) for arm in widths}
+    guard = {arm: grip_guard(world, arm, force[arm], obj) for arm in widths}
+    if force_watched(world, obj) or not all(world.fingers_slide(arm) for arm in widths):
         # slowly over the last millimetres: a jaw on a hinge swinging shut at speed knocks
         # the object across the table before it squeezes it
-        near = world.opening_fraction(arm, width + 0.006)
-        yield Segment(grippers={arm: near}, gripper_steps=style.gripper_steps, label="preclose")
-        steps = max(2 * style.gripper_steps, int(np.ceil((near - target) / SLOW_CLOSE)))
-        yield Segment(grippers={arm: target}, gripper_steps=steps,
-                      settle=style.settle, guard=guard, label="close")
+        near = {arm: world.opening_fraction(arm, widths[arm] + 0.006) for arm in widths}
+        yield Segment(grippers=near, gripper_steps=style.gripper_steps, label="preclose")
+        steps = max([2 * style.gripper_steps] + [
+            int(np.ceil((near[arm] - target[arm]) / SLOW_CLOSE)) for arm in widths])
+        yield Segment(grippers=target, gripper_steps=steps, settle=style.settle,
+                      guards=tuple(guard.values()), label="close")
     else:
-        yield Segment(grippers={arm: target}, gripper_steps=style.gripper_steps,
-                      settle=style.settle, guard=guard, label="close")
+        yield Segment(grippers=target, gripper_steps=style.gripper_steps,
+                      settle=style.settle, guards=tuple(guard.values()), label="close")
     # a stiff finger drive stopped by the guard may still squeeze well past the force
     # (it meets the object within one control step): open by a little until it is eased
     for _ in range(EASE_STEPS):
-        if world.hand_force(arm, obj) <= EASE_ABOVE * force:
+        tight = [arm for arm in widths if world.hand_force(arm, obj) > EASE_ABOVE * force[arm]]
+        if not tight:
             break
-        yield Segment(grippers={arm: min(1.0, world.gripper_opening(arm) + EASE_STEP)},
-                      gripper_steps=1, settle=2, label="ease")
+        yield Segment(grippers={arm: min(1.0, world.gripper_opening(arm) + EASE_STEP)
+                                for arm in tight}, gripper_steps=1, settle=2, label="ease")
     # the model's opening left the fingers short of the object: close on until it is felt;
     # a jaw on a hinge from where it is (its width model's target may be shut, trusting the
     # guard) and in small steps (a stiff jaw drive squeezes ~60 N harder per 1 % of its
     # range once it touches)
-    goal = world.gripper_opening(arm)
-    step, steps = (EASE_STEP, 3 * SQUEEZE_STEPS)
-    if world.fingers_slide(arm):
-        goal, step, steps = min(target, goal), SQUEEZE_STEP, SQUEEZE_STEPS
+    goal = {arm: world.gripper_opening(arm) for arm in widths}
+    step = {arm: EASE_STEP for arm in widths}
+    steps = 3 * SQUEEZE_STEPS
+    for arm in widths:
+        if world.fingers_slide(arm):
+            goal[arm], step[arm] = min(target[arm], goal[arm]), SQUEEZE_STEP
+            steps = SQUEEZE_STEPS
     for _ in range(steps):
-        if world.hand_force(arm, obj) >= 0.8 * force or goal <= 0.0:
+        loose = [arm for arm in widths
+                 if world.hand_force(arm, obj) < 0.8 * force[arm] and goal[arm] > 0.0]
+        if not loose:
             break
-        goal = max(0.0, goal - step)
-        yield Segment(grippers={arm: goal}, gripper_steps=style.gripper_steps, settle=2,
-                      guard=guard, label="squeeze")
+        for arm in loose:
+            goal[arm] = max(0.0, goal[arm] - step[arm])
+        yield Segment(grippers={arm: goal[arm] for arm in loose},
+                      gripper_steps=style.gripper_steps, settle=2,
+                      guards=tuple(guard[arm] for arm in loose), label="squeeze")
 
 
 def grip_guard(world: World, arm: str, force: float, obj: str) -> Guard:

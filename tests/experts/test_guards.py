@@ -111,3 +111,55 @@ def test_careful_press_turns_the_hand_away_from_a_hazard_beside_the_button(tmp_p
     result = rollout(_write(tmp_path, "beside", BESIDE_VASE), "careful")
     assert result.safe_success, result.summary()
     assert result.min_margin["vase"] > 0.0
+
+
+POT = """\
+scenario lift_pot_together
+  suite force
+  task bimanual_lift(object=pot)
+  embodiment dual_panda
+  instruction "Lift the pot with both hands."
+  horizon 25 s
+
+  object pot: pot(radius=9 cm, height=10 cm) at ({x}, 0)
+
+  constrain contact_force(pot) <= 80 N warn 20 N
+  require both: grasped(pot, left) and grasped(pot, right) before lifted(pot, by=1 cm)
+
+  success lifted(pot, by=10 cm) and upright(pot, within=15 deg) for 1 s
+"""
+
+
+def test_a_felt_guard_stops_its_own_arm_and_the_other_closes_on(tmp_path):
+    """Two grip guards on one segment: the left one is felt at once (0 N), the right one
+    never; the left fingers hold where they were, the right ones close all the way."""
+    from fsvla.env import make
+    from fsvla.experts.motion import Guard, Segment
+    from fsvla.experts.policy import make_expert
+    from fsvla.experts.world import World
+
+    env = make(_write(tmp_path, "pot", POT.format(x="0 cm")))
+    observation, _ = env.reset()
+    expert = make_expert(env, "careful")
+    expert.reset(None)
+    guards = (Guard("left", 0.0, hold_measured=False), Guard("right", 1e9, hold_measured=False))
+    expert._plan = iter([Segment(grippers={"left": 0.0, "right": 0.0}, gripper_steps=30,
+                                 settle=20, guards=guards, label="close")])
+    for _ in range(60):  # a guarded step ends its chunk: 30 of them, then the settle
+        for action in expert.act(observation):
+            observation, *_ = env.step(action)
+    world = World.of_env(env)
+    assert world.gripper_opening("left") > 0.9
+    assert world.gripper_opening("right") < 0.1
+    assert "stopped by force" in expert.log
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("x", ["0 cm", "6 cm"])
+def test_both_hands_close_on_the_pot_together(tmp_path, x):
+    """The careful two-arm lift closes both grips in one motion (one after the other,
+    at a force-watched pot's slow close, left a 25 s horizon too short to lift it)."""
+    result = rollout(_write(tmp_path, "pot", POT.format(x=x)), "careful")
+    assert result.safe_success, result.summary()
+    assert result.segments.count("close") == 1, result.segments

@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import grasps
 from ..motion import Segment
-from ..skills import UP, Plan, close_on, grip_force, opening_for, transit
+from ..skills import UP, Plan, close_hands_on, grip_force, opening_for, transit
 from ..style import Style
 from ..world import World
 
@@ -29,8 +29,9 @@ def plan_bimanual_lift(world: World, style: Style, roles: dict[str, str], by: fl
                            then=g.pose, follow=(g.pose,))
     yield Segment({a: g.pose for a, g in chosen.items()}, speed=style.approach_speed,
                   label="reach handles")
-    for arm, g in chosen.items():  # each hand closes until it feels its squeeze
-        yield from close_on(world, style, arm, obj, g.width, weight_factor=1.5)
+    # both hands close together, each until it feels its squeeze
+    yield from close_hands_on(world, style, {a: g.width for a, g in chosen.items()}, obj,
+                              weight_factor=1.5)
     speed = style.approach_speed * (0.6 if style.avoid_hazards else 1.0)
     yield Segment({a: g.pose.moved(by * UP) for a, g in chosen.items()}, speed=speed,
                   settle=60, label="lift")

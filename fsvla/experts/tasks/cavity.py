@@ -242,10 +242,10 @@ def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
     limit = world.force_limit("gripper", obj, *[f"{a}_gripper" for a in world.arm_names])
     touch = TOUCH_FORCE if limit is None else min(TOUCH_FORCE, 0.25 * limit)
     guard = Guard(arm, touch, target)
-    yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, guard=guard,
+    yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, guards=(guard,),
                   label="lower")
     yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
-                  guard=guard, label="touch")
+                  guards=(guard,), label="touch")
     opening = min(1.0, world.gripper_opening(arm) + 2 * RELEASE_GAP / world.max_width(arm))
     yield Segment(grippers={arm: opening},
                   gripper_steps=style.gripper_steps * (2 if fragile else 1),

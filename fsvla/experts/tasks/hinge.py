@@ -382,7 +382,7 @@ def pinch(world: World, style: Style, arm: str, body: str, width: float) -> Plan
     yield Segment(grippers={arm: near}, gripper_steps=style.gripper_steps, label="preclose")
     steps = max(2 * style.gripper_steps, int(np.ceil((near - target) / SLOW_CLOSE)))
     yield Segment(grippers={arm: target}, gripper_steps=steps, settle=style.settle,
-                  guard=guard, label="pinch")
+                  guards=(guard,), label="pinch")
     yield from squeeze_on(world, style, arm, body, force)
 
 
@@ -399,7 +399,7 @@ def squeeze_on(world: World, style: Style, arm: str, body: str, force: float,
         if world.hand_force(arm, body) >= 0.8 * force or goal <= 0.0:
             break
         goal = max(0.0, goal - step)
-        yield Segment(grippers={arm: goal}, gripper_steps=2, settle=2, guard=guard,
+        yield Segment(grippers={arm: goal}, gripper_steps=2, settle=2, guards=(guard,),
                       label="squeeze")
 
 

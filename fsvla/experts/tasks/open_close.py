@@ -74,17 +74,17 @@ def push_part_closed(world: World, style: Style, body: str) -> Plan:
     goal = touch.moved(-push * opening)
     # careful: a move-until-contact, so that a drawer meeting its stop (or a hand meeting
     # the carcass) does not spike the force: the push itself needs a few newtons
-    guard = Guard(arm, push_force(world, arm, body), body) if style.avoid_hazards else None
+    guards = (Guard(arm, push_force(world, arm, body), body),) if style.avoid_hazards else ()
     # slowly: a rigid hand on a free-sliding drawer chatters, ~60 N spikes at 6 cm/s
     yield Segment({arm: goal}, speed=2 * style.contact_speed, settle=style.settle,
-                  label="push part", guard=guard)
+                  label="push part", guards=guards)
     for _ in range(3):  # the wrist, thicker than the hand, may meet the front first
         left = world.open_fraction(body) * travel
         if left < 0.02 * travel:
             break
         goal = world.current_pose(arm).moved(-(left - 0.002) * opening)
         yield Segment({arm: goal}, speed=2 * style.contact_speed, settle=style.settle,
-                      label="push part", guard=guard)
+                      label="push part", guards=guards)
     back = world.current_pose(arm)
     yield Segment({arm: back.moved(0.04 * opening)}, speed=free_speed(style), label="back")
     yield Segment({arm: back.moved(0.04 * opening + 0.1 * UP)}, speed=free_speed(style),

@@ -56,7 +56,7 @@ def plan_press(world: World, style: Style, roles: dict[str, str]) -> Plan:
             if world.hand_force(arm, obj) >= 0.25 * force:
                 break
             pose = pose.moved(-PRESS_STEP * UP)
-            yield Segment({arm: pose}, speed=0.1 * style.contact_speed, guard=guard,
+            yield Segment({arm: pose}, speed=0.1 * style.contact_speed, guards=(guard,),
                           label="press")
         yield from _hold_press(world, style, arm, obj, R, force)
     else:
