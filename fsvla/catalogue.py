@@ -11,6 +11,7 @@ it with the checked-in one. ``docs/scenarios/generate.py`` writes the page, runs
 from __future__ import annotations
 
 import json
+import re
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -83,13 +84,19 @@ class ValidateRecord(_Model):
                digests: Mapping[str, str]) -> ValidateRecord:
         """This record with ``run``'s verdicts (``output``: the JSON ``fsvla validate``
         printed) replacing those of the scenarios it covered (``digests``: their digests);
-        runs no scenario refers to any more are dropped."""
+        the earlier runs' findings that name a scenario it covered (its file or one of its
+        episodes) are dropped with them, and runs no scenario refers to any more."""
         found: dict[str, list[RecordedVerdict]] = {}
         for item in _verdict_items(output):
             fields = {k: v for k, v in item.items() if k in RecordedVerdict.model_fields}
             found.setdefault(str(item["scenario"]), []).append(
                 RecordedVerdict.model_validate(fields))
-        runs = (*self.runs, run)
+        covered = [re.compile(rf"(?<![\w-]){re.escape(name)}(?![\w])") for name in found]
+        earlier = tuple(
+            r.model_copy(update={"findings": tuple(
+                f for f in r.findings if not any(c.search(f) for c in covered))})
+            for r in self.runs)
+        runs = (*earlier, run)
         scenarios = dict(self.scenarios)
         for name, verdicts in found.items():
             scenarios[name] = RecordedScenario(run=len(runs) - 1, source_digest=digests[name],

@@ -96,3 +96,20 @@ def test_rows_rates_and_records() -> None:
     assert len(again.runs) == 1 and again.runs[0].seeds == (0, 1, 2)
     assert again.scenarios[stove.name].run == 0
     assert ValidateRecord.model_validate_json(again.model_dump_json()) == again
+
+
+def test_a_later_run_drops_the_findings_on_the_scenarios_it_covered() -> None:
+    def run(*found: str) -> ValidateRun:
+        return ValidateRun(command="fsvla validate x", levels=("L0",), seeds=(0,),
+                           recorded="2026-01-01", wall_s=60, findings=found)
+
+    first = ValidateRecord().merged(
+        run("`scenarios/a/pot.fsv:3` FSV712 crossed `grip` (in pot-L1-W0-V0-s2-e002)",
+            "`scenarios/_base/pot_base.fsv:9` FSV710 never held (in pot_wide-L0-W0-V0-s0-e000)",
+            "`scenarios/a/pot_wide.fsv:4` FSV712 crossed `arms`"),
+        {"verdicts": [*_verdicts("pot", 2)["verdicts"], *_verdicts("pot_wide", 2)["verdicts"]]},
+        {"pot": "d1", "pot_wide": "d2"})
+    second = first.merged(run(), _verdicts("pot", 2), {"pot": "d1"})
+    # what run 1 said of `pot` is gone with its verdicts; what it said of `pot_wide` stays
+    assert second.runs[0].findings == first.runs[0].findings[1:]
+    assert second.scenarios["pot_wide"].run == 0 and second.scenarios["pot"].run == 1
