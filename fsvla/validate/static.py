@@ -6,7 +6,9 @@ canonical (L0, seed 0) layout:
 * **FSV701 reach** — each task object must be within reach of some arm (of every arm for
   a two-arm lift): the point of the object's bounding box nearest the arm's base is asked
   of the arm's IK (:mod:`fsvla.validate.robots`). Reaching the nearest point is necessary
-  for any task, so a miss is a sure sign, and the gap says by how much.
+  for any task, so a miss is a sure sign, and the gap says by how much. A task that moves
+  an articulated part (open, close, insert) must also reach the part's knob or handle
+  where the part starts.
 * **FSV702 gripper** — an object the task grasps (pick_place, lift, insert, pour, stack,
   handover) must have a part the gripper can close around: the thinnest extent of its
   thinnest collision piece (a mug's handle, a bowl's wall, a block's shortest side) must
@@ -34,9 +36,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.assets.model import RigidAsset, Shape, SphereShape
+from fsvla.compiler.assets.model import (
+    ArticulatedAsset,
+    RigidAsset,
+    Shape,
+    SphereShape,
+    start_positions,
+)
 from fsvla.compiler.collision import min_distance, pieces_of, shape_vertices
-from fsvla.compiler.pose import pose_matrix
+from fsvla.compiler.pose import axis_angle_matrix, pose_matrix
 from fsvla.compiler.scene import LoweringError, SceneBody, SceneSpec
 from fsvla.compiler.variants.errors import cm, quantity
 from fsvla.dsl.catalog import robot_parts
@@ -53,6 +61,8 @@ GRASPED_TASKS = frozenset({"pick_place", "lift", "insert", "pour", "stack", "han
 LIFTED_TASKS = GRASPED_TASKS | {"bimanual_lift"}
 PLACING_TASKS = frozenset({"pick_place", "stack", "insert", "pour", "push"})
 PLACE_GRID = 5  # place points per side of the target's top
+PART_TASKS = frozenset({"open", "close", "insert"})  # tasks that move an articulated part
+GRIP_FEATURES = ("knob", "handle")  # what of a part the hand takes it by
 
 
 @dataclass(frozen=True)
@@ -158,7 +168,82 @@ def reach_findings(layout: Layout) -> list[Diagnostic]:
                    f"{cm(base[1])}, {cm(base[2])}) is out of reach with the gripper pointing "
                    "down or tilted up to 90 deg"),),
             help=f"move `{name}` at least {cm(gap)} closer to the robot's base"))
+    if not found and scenario.task.name in PART_TASKS:
+        found += _part_reach_findings(layout, model)
     return found
+
+
+def _part_reach_findings(layout: Layout, model: Any) -> list[Diagnostic]:
+    """FSV701 for the part a task moves: the knob or handle of an articulated task object
+    must be within some arm's reach where the part starts (a lid standing open puts its
+    knob high above the box's back edge)."""
+    scenario = layout.scenario
+    found = []
+    for name in dict.fromkeys(scenario.task.roles.values()):
+        body, spec = layout.body(name), scenario.object(name)
+        grip = part_grip_point(body) if body is not None and spec is not None else None
+        if grip is None:
+            continue
+        part, feature, point = grip
+        gaps = {arm: model.reach_gap(arm, point) for arm in model.arms}
+        if min(gaps.values()) <= 0.0:
+            continue
+        arm = min(gaps, key=lambda a: gaps[a])
+        gap = round(gaps[arm], 3)
+        who = embodiment_arm(scenario.embodiment, arm, len(gaps))
+        fraction = float(body.asset.params.get("open", 0.0) or 0.0)
+        where = f"open {fraction:.0%}" if fraction > 0.0 else "shut"
+        x, y, z = (float(v) + 0.0 for v in np.round(point, 4))
+        found.append(Diagnostic(
+            code=codes.REACH, severity=Severity.WARNING,
+            message=f"{who} cannot reach the {feature} of `{name}`'s `{part}` ({where}) at "
+                    f"({cm(x)}, {cm(y)}, {cm(z)}): {cm(gap)} beyond its workspace",
+            span=layout.located.span(spec.source), label="out of reach",
+            notes=((f"the task moves `{part}` by its {feature}, which the hand must reach "
+                    "first, with the gripper pointing down or tilted up to 90 deg"),),
+            help=f"move `{name}` at least {cm(gap)} closer to the robot's base"
+                 + (", or start it less open" if fraction > 0.0 else "")))
+    return found
+
+
+def part_grip_point(body: SceneBody) -> tuple[str, str, NDArray[np.float64]] | None:
+    """(part, feature, world point): the first part of an articulated ``body`` with a
+    ``knob`` or ``handle`` shape on its link, that shape's centre where the body starts
+    (its ``open`` fraction); None for a rigid body or one without such a part."""
+    asset = body.asset
+    if not isinstance(asset, ArticulatedAsset):
+        return None
+    start = start_positions(asset.joints, [part.joint for part in asset.parts], asset.params)
+    links = {link.name: link for link in asset.links}
+    by_child = {joint.child: joint for joint in asset.joints}
+    for part in asset.parts:
+        link = links.get(part.link)
+        shape = next((s for s in (link.collision if link else ()) if s.name in GRIP_FEATURES),
+                     None)
+        if shape is None:
+            continue
+        matrix = pose_matrix(body.pose) @ _link_matrix(part.link, by_child, start)
+        point = matrix @ np.array([*shape.pose.position, 1.0])
+        return part.name, shape.name, point[:3]
+    return None
+
+
+def _link_matrix(link: str, by_child: dict[str, Any], positions: dict[str, float]
+                 ) -> NDArray[np.float64]:
+    """The pose of ``link`` in the root link's frame, its joints at ``positions`` (0 where
+    not named)."""
+    matrix = np.eye(4)
+    while link in by_child:
+        joint = by_child[link]
+        motion = np.eye(4)
+        value = positions.get(joint.name, 0.0)
+        if joint.type in ("revolute", "continuous"):
+            motion[:3, :3] = axis_angle_matrix(joint.axis, value)
+        elif joint.type == "prismatic":
+            motion[:3, 3] = value * np.asarray(joint.axis, dtype=np.float64)
+        matrix = pose_matrix(joint.origin) @ motion @ matrix
+        link = joint.parent
+    return matrix
 
 
 def embodiment_arm(embodiment: str, arm: str, arms: int) -> str:

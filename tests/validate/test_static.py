@@ -76,6 +76,29 @@ def test_far_out_of_reach_on_so101_also_fails_the_layout(tmp_path: Path) -> None
     assert only(found, "FSV603").span.line == 7  # the compiler's own reach margin, too
 
 
+def test_the_knob_of_a_lid_standing_open_out_of_reach(tmp_path: Path) -> None:
+    """The box is in reach, but its lid, open 90 %, holds its knob high over the box's
+    back edge: closing it starts beyond the arm."""
+    body = """
+  object lidded_box: lidded_box(size=(17.4 cm, 13.3 cm, 10 cm), open={open}) at (28.4 cm, 5.2 cm)
+  success {success}(lidded_box) for 1 s
+"""
+    path = write(tmp_path, "far_lid", body.format(open=0.9, success="closed"),
+                 task="close(object=lidded_box)")
+    located, found = findings(path)
+    reach = only(found, "FSV701")
+    assert reach.message == ("panda cannot reach the knob of `lidded_box`'s `lid` (open 90%) at "
+                             "(40.41 cm, 5.2 cm, 26.7 cm): 1.1 cm beyond its workspace")
+    assert (reach.span.line, reach.span.column) == (7, 10)
+    assert span_text(reach.span, located.sources).startswith("lidded_box: lidded_box(")
+    assert reach.help == ("move `lidded_box` at least 1.1 cm closer to the robot's base, or "
+                          "start it less open")
+    # shut, the knob is at the box's front edge, 20 cm nearer the robot: in reach
+    path = write(tmp_path, "far_lid", body.format(open=0.0, success="opened"),
+                 task="open(object=lidded_box)")
+    assert [d.code for d in findings(path)[1]] == []
+
+
 def test_a_force_limit_below_the_weight(tmp_path: Path) -> None:
     path = write(tmp_path, "weak_grip", """
   object cube: block(size=(4 cm, 4 cm, 4 cm), mass=0.5 kg) at (0, 10 cm)
