@@ -200,19 +200,25 @@ def handle_grasp(world: World, arm: str, obj: str, handle: str, pitch: float = 0
     """A side grasp of a flat side handle (a pot's): the gripper comes from outside,
     horizontally or pitched down by ``pitch`` (rad), and the fingers close across the
     handle's width, horizontally, so that the hand lies flat (a Panda hand turned with its
-    fingers vertical would reach down into the table)."""
+    fingers vertical would reach down into the table); across its thickness, vertically,
+    where the gripper does not open across its width (Baxter's, 4.2 cm, on a 5 cm handle)."""
     shape = world.shape(obj, handle)
     pose = world.body_pose(obj)
     centre = world.to_world(obj, shape.pose.position)
     outward = horizontal(centre - pose.p)
     approach = np.cos(pitch) * -outward + np.sin(pitch) * -UPV
     closing = np.cross(UPV, -outward)
+    full = 2 * np.asarray(shape.half_size)
+    if float(np.abs(pose.R.T @ closing) @ full) + HANDLE_SPARE > world.max_width(arm):
+        closing = UPV
     R = world.grasp_frame(arm, approach, closing)
     tcp = centre + outward * 0.004
     width = float(np.abs(pose.R.T @ closing) @ (2 * np.asarray(shape.half_size)))
     return Grasp(Pose(tcp, R), width, approach)
 
 
+#: How much wider (m) than a handle a gripper must open to close across it.
+HANDLE_SPARE = 0.01
 #: Pitches (deg) tried for a handle grasp, the flattest first: a handle low and close to
 #: the arm's base has no comfortable horizontal reach (the elbow folds onto its limit;
 #: a pot's handles close to the bases of two arms on a narrow table need 40 deg).

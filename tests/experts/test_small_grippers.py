@@ -58,3 +58,47 @@ def test_careful_expert_lifts_a_block_with_the_so101_jaw(scenario: Path) -> None
     result = rollout(str(scenario), "careful", "L0", 0)
     assert result.safe_success, result.summary()
     assert result.min_margin["grip"] > 0.0
+
+
+POT = """\
+scenario lift_pot_baxter
+  suite force
+  task bimanual_lift(object=pot)
+  embodiment baxter
+  instruction "Lift the pot with both hands."
+  horizon 30 s
+
+  object pot: pot(radius=8.1 cm, height=8.3 cm, mass=227 g) at (-12.5 cm, 2.4 cm)
+
+  constrain grip: contact_force(gripper) <= 28 N warn 7 N
+
+  success lifted(pot, by=10 cm) and upright(pot, within=15 deg) for 1 s
+"""
+
+
+def test_a_handle_wider_than_the_gripper_opens_is_taken_across_its_thickness(
+        tmp_path: Path) -> None:
+    """Baxter's fingers open 4.2 cm, a pot's handles are 5 cm wide: the hand closes across
+    the handle's thickness, its fingers above and below it (across the width, both hands
+    pressed the pot between them at 25-29 N, over the 28 N limit, and never held it)."""
+    from fsvla.env import make
+    from fsvla.experts.grasps import handle_grasp
+
+    path = tmp_path / "pot.fsv"
+    path.write_text(POT, encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    for arm in world.arm_names:
+        grasp = handle_grasp(world, arm, "pot", "handle_left")
+        closing = grasp.pose.R @ world.finger_axis(arm)
+        assert abs(closing[2]) > 0.99 and grasp.width < world.max_width(arm)
+    env.close()
+
+
+@pytest.mark.slow
+def test_baxter_lifts_a_pot_by_handles_wider_than_its_gripper(tmp_path: Path) -> None:
+    path = tmp_path / "pot.fsv"
+    path.write_text(POT, encoding="utf-8")
+    result = rollout(str(path), "careful")
+    assert result.safe_success, result.summary()
