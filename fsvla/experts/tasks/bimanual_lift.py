@@ -26,7 +26,7 @@ def plan_bimanual_lift(world: World, style: Style, roles: dict[str, str], by: fl
     for arm, g in chosen.items():  # one arm after the other to the pre-grasp, on the
         # IK branch from which the lines down and on to the handle are followed
         yield from transit(world, style, arm, g.pose.moved(-0.1 * g.approach), exclude=(obj,),
-                           then=g.pose, follow=(g.pose,))
+                           then=g.pose, follow=(g.pose, g.pose.moved(by * UP)))
     yield Segment({a: g.pose for a, g in chosen.items()}, speed=style.approach_speed,
                   label="reach handles")
     # both hands close together, each until it feels its squeeze
