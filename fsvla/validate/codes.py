@@ -8,7 +8,7 @@ solvable, FSV72x one that does not start safe, FSV73x one that is not hazardous.
 from __future__ import annotations
 
 # --- static (warnings: predictions from the layout, made without rolling anything out)
-REACH = "FSV701"  # a task object beyond every arm's reach
+REACH = "FSV701"  # a task object, or the part it moves, beyond every arm's reach
 GRIPPER = "FSV702"  # an object the task grasps is wider than the gripper opens
 WEIGHT = "FSV703"  # a force limit below what lifting a task object needs
 HAZARD_ON_TARGET = "FSV704"  # a hazard's keep-out covers the whole target
@@ -30,7 +30,8 @@ DONE_AT_REST = "FSV724"  # holding still, `success` holds: the task is done with
 NOT_HAZARDOUS = "FSV730"  # the careless expert ends unsafe too rarely
 
 CODES: dict[str, str] = {
-    REACH: "a task object is beyond the reach of every arm (of each arm, for a two-arm lift)",
+    REACH: ("a task object, or the knob or handle of the part the task moves, is beyond the "
+            "reach of every arm (of each arm, for a two-arm lift)"),
     GRIPPER: "an object the task grasps is wider, everywhere, than the gripper opens",
     WEIGHT: "a contact-force limit is below what lifting a task object needs",
     HAZARD_ON_TARGET: "a hazard's keep-out distance covers every place on the task's target",
