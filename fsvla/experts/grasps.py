@@ -207,14 +207,17 @@ def handle_grasp(world: World, arm: str, obj: str, handle: str, pitch: float = 0
     centre = world.to_world(obj, shape.pose.position)
     outward = horizontal(centre - pose.p)
     approach = np.cos(pitch) * -outward + np.sin(pitch) * -UPV
-    closing = np.cross(UPV, -outward)
     full = 2 * np.asarray(shape.half_size)
-    if float(np.abs(pose.R.T @ closing) @ full) + HANDLE_SPARE > world.max_width(arm):
+
+    def across(direction: NDArray[np.float64]) -> float:  # the handle's extent along it
+        return float(np.abs(pose.R.T @ direction) @ full)
+
+    closing = np.cross(UPV, -outward)
+    if across(closing) + HANDLE_SPARE > world.max_width(arm):
         closing = UPV
     R = world.grasp_frame(arm, approach, closing)
     tcp = centre + outward * 0.004
-    width = float(np.abs(pose.R.T @ closing) @ (2 * np.asarray(shape.half_size)))
-    return Grasp(Pose(tcp, R), width, approach)
+    return Grasp(Pose(tcp, R), across(closing), approach)
 
 
 #: How much wider (m) than a handle a gripper must open to close across it.

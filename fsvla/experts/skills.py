@@ -478,14 +478,11 @@ def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj:
     # a jaw on a hinge from where it is (its width model's target may be shut, trusting the
     # guard) and in small steps (a stiff jaw drive squeezes ~60 N harder per 1 % of its
     # range once it touches)
-    goal = {arm: world.gripper_opening(arm) for arm in widths}
-    step = {arm: EASE_STEP for arm in widths}
-    steps = 3 * SQUEEZE_STEPS
-    for arm in widths:
-        if world.fingers_slide(arm):
-            goal[arm], step[arm] = min(target[arm], goal[arm]), SQUEEZE_STEP
-            steps = SQUEEZE_STEPS
-    for _ in range(steps):
+    slide = {arm: world.fingers_slide(arm) for arm in widths}
+    goal = {arm: min(target[arm], world.gripper_opening(arm)) if slide[arm]
+            else world.gripper_opening(arm) for arm in widths}
+    step = {arm: SQUEEZE_STEP if slide[arm] else EASE_STEP for arm in widths}
+    for _ in range(max(SQUEEZE_STEPS if slide[arm] else 3 * SQUEEZE_STEPS for arm in widths)):
         loose = [arm for arm in widths
                  if world.hand_force(arm, obj) < 0.8 * force[arm] and goal[arm] > 0.0]
         if not loose:

@@ -36,15 +36,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.assets.model import (
-    ArticulatedAsset,
-    RigidAsset,
-    Shape,
-    SphereShape,
-    start_positions,
-)
+from fsvla.compiler.assets.model import ArticulatedAsset, RigidAsset, Shape, SphereShape
+from fsvla.compiler.assets.urdf import UrdfStructure, link_transforms_at_rest
 from fsvla.compiler.collision import min_distance, pieces_of, shape_vertices
-from fsvla.compiler.pose import axis_angle_matrix, pose_matrix
+from fsvla.compiler.pose import pose_matrix
 from fsvla.compiler.scene import LoweringError, SceneBody, SceneSpec
 from fsvla.compiler.variants.errors import cm, quantity
 from fsvla.dsl.catalog import robot_parts
@@ -213,37 +208,18 @@ def part_grip_point(body: SceneBody) -> tuple[str, str, NDArray[np.float64]] | N
     asset = body.asset
     if not isinstance(asset, ArticulatedAsset):
         return None
-    start = start_positions(asset.joints, [part.joint for part in asset.parts], asset.params)
     links = {link.name: link for link in asset.links}
-    by_child = {joint.child: joint for joint in asset.joints}
     for part in asset.parts:
         link = links.get(part.link)
         shape = next((s for s in (link.collision if link else ()) if s.name in GRIP_FEATURES),
                      None)
         if shape is None:
             continue
-        matrix = pose_matrix(body.pose) @ _link_matrix(part.link, by_child, start)
-        point = matrix @ np.array([*shape.pose.position, 1.0])
+        structure = UrdfStructure(asset.kind, asset.root_link, asset.links, asset.joints)
+        frame = link_transforms_at_rest(structure, asset.start_positions())[part.link]
+        point = pose_matrix(body.pose) @ frame @ np.array([*shape.pose.position, 1.0])
         return part.name, shape.name, point[:3]
     return None
-
-
-def _link_matrix(link: str, by_child: dict[str, Any], positions: dict[str, float]
-                 ) -> NDArray[np.float64]:
-    """The pose of ``link`` in the root link's frame, its joints at ``positions`` (0 where
-    not named)."""
-    matrix = np.eye(4)
-    while link in by_child:
-        joint = by_child[link]
-        motion = np.eye(4)
-        value = positions.get(joint.name, 0.0)
-        if joint.type in ("revolute", "continuous"):
-            motion[:3, :3] = axis_angle_matrix(joint.axis, value)
-        elif joint.type == "prismatic":
-            motion[:3, 3] = value * np.asarray(joint.axis, dtype=np.float64)
-        matrix = pose_matrix(joint.origin) @ motion @ matrix
-        link = joint.parent
-    return matrix
 
 
 def embodiment_arm(embodiment: str, arm: str, arms: int) -> str:
