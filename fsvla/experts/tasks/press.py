@@ -4,10 +4,12 @@ centimetre into the object at full speed."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ..motion import Guard, Pose, Segment
-from ..skills import DOWN, UP, Plan, branch_for_path, nearest_arm, transit
+from ..skills import DOWN, UP, Plan, branch_for_path, horizontal, nearest_arm, transit
 from ..style import Style
 from ..world import World, box_distance
 from .common import HAND_HALF_LENGTH, retreat_home
@@ -93,36 +95,71 @@ def _press_frame(world: World, style: Style, arm: str, obj: str, top: np.ndarray
     """The hand pointing down over ``top``, its long (closing) axis along y; careful: turned
     about the vertical (by 45° steps) to where the hand's two ends stay farthest from the
     hazards and the other objects beside the button (a hand 21 cm long lying across a
-    neighbour comes down on it), among the turns the arm reaches above the top."""
+    neighbour comes down on it), among the turns the arm reaches above the top. Where the
+    arm holds no hand pointing down there at all, one leaning (:func:`_leaning_frame`)."""
     default = world.grasp_frame(arm, DOWN, np.array([0.0, 1.0, 0.0]))
-    if not style.avoid_hazards:
-        return default
-    boxes = [(o.lo, o.hi, o.margin) for o in world.obstacles(exclude=(obj,))]
-    for body in world.scene.bodies:
-        if body.name not in (obj, "table"):
-            lo, hi = world.bounds(body.name)
-            boxes.append((lo, hi, 0.0))
-    if not boxes:
-        return default
-    level = top + HAND_ABOVE * UP  # the hand's body, just above the top
     reach = world.hand_reach(arm)
-    best: tuple[float, np.ndarray] | None = None
-    for yaw in np.deg2rad([90.0, 45.0, 0.0, 135.0]):  # y first: the default
-        closing = np.array([np.cos(yaw), np.sin(yaw), 0.0])
-        R = world.grasp_frame(arm, DOWN, closing)
+
+    def followed(R: np.ndarray) -> bool:
         # reached above the top and on the way down to it, on one branch (a five-joint arm
         # holds a turned hand high above the button, not down on it)
-        if branch_for_path(world, arm, (Pose(top + 0.05 * UP, R), Pose(top + reach * UP, R))) is None:
-            continue
-        ends = (level + HAND_HALF_LENGTH * closing, level - HAND_HALF_LENGTH * closing)
-        clearance = min(box_distance(p, lo, hi) - margin for lo, hi, margin in boxes for p in ends)
-        if best is None or clearance > best[0] + 0.005:
-            best = (clearance, R)
-    return default if best is None else best[1]
+        return branch_for_path(world, arm, (Pose(top + 0.05 * UP, R),
+                                            Pose(top + reach * UP, R))) is not None
+
+    def out_of_reach(R: np.ndarray) -> bool:
+        # not even roughly (as a straight move tracks it: 5 mm, 3 deg), on any branch
+        pose = Pose(top + reach * UP, R)
+        result = world.kinematics(arm).inverse(tuple(pose.p), pose.quat, restarts=8)
+        return not result.ok(position_tol=5e-3, rotation_tol=5e-2)
+
+    if style.avoid_hazards:
+        boxes = [(o.lo, o.hi, o.margin) for o in world.obstacles(exclude=(obj,))]
+        for body in world.scene.bodies:
+            if body.name not in (obj, "table"):
+                lo, hi = world.bounds(body.name)
+                boxes.append((lo, hi, 0.0))
+        level = top + HAND_ABOVE * UP  # the hand's body, just above the top
+        best: tuple[float, np.ndarray] | None = None
+        for yaw in np.deg2rad([90.0, 45.0, 0.0, 135.0]) if boxes else ():  # y first
+            closing = np.array([np.cos(yaw), np.sin(yaw), 0.0])
+            R = world.grasp_frame(arm, DOWN, closing)
+            if not followed(R):
+                continue
+            ends = (level + HAND_HALF_LENGTH * closing, level - HAND_HALF_LENGTH * closing)
+            clearance = min(box_distance(p, lo, hi) - margin for lo, hi, margin in boxes
+                            for p in ends)
+            if best is None or clearance > best[0] + 0.005:
+                best = (clearance, R)
+        if best is not None:
+            return best[1]
+    if out_of_reach(default):
+        leaning = _leaning_frame(world, arm, top, followed)
+        if leaning is not None:
+            return leaning
+    return default
+
+
+def _leaning_frame(world: World, arm: str, top: np.ndarray,
+                   followed: Callable[[np.ndarray], bool]) -> np.ndarray | None:
+    """Where no hand pointing down is reached over ``top``, on any branch (a small arm
+    pressing far out and low: an SO-101 36 cm from its base), the hand leaning out from
+    the base, or back toward it, by the least of LEANS that is; its fingers close across
+    the lean, so that they stay level. None if none is."""
+    out = horizontal(top - world.base_position(arm))
+    across = np.cross(UP, out)
+    for lean in np.deg2rad(LEANS):
+        approach = np.cos(abs(lean)) * DOWN + np.sin(lean) * out
+        R = world.grasp_frame(arm, approach, across)
+        if followed(R):
+            return R
+    return None
 
 
 #: How far above the pressed top (m) the hand's body is measured for clearance.
 HAND_ABOVE = 0.03
+#: Leans (deg) of the hand from pointing down that :func:`_leaning_frame` tries in turn:
+#: positive out, away from the arm's base; negative back toward it.
+LEANS = (20.0, 35.0, 50.0, 65.0, -20.0, -35.0, -50.0)
 
 
 __all__ = ["LEAST_PRESS", "PRESS_FORCE", "plan_press", "press_force"]
