@@ -56,6 +56,10 @@ SLOW_CLOSE = 0.005
 #: How far (m) beyond a pose, away from the arm's base, the arm must still reach for the
 #: pose to count as inside the reach rather than at its edge.
 REACH_SLACK = 0.05
+#: How far (m) a held load's lowest point may hang below its origin before :func:`place`
+#: sets that point down instead of the origin (a bar handed over and held a little askew,
+#: 1-1.2 cm, is set down as it always was).
+SAG = 0.02
 #: Height of the hand above its tool centre point (m), for clearing obstacles beneath it.
 HAND_RADIUS = 0.06
 
@@ -401,7 +405,7 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     R = world.current_pose(arm).R if rotation is None else rotation
     offset = R @ held_offset(world, arm, obj)
     goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
-    below = float(offset[2]) + 0.03
+    below = float(offset[2]) + 0.03 + hanging(world, obj)
     heavy = float(world.asset(obj).mass) > LIGHT_LOAD
     carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
         if style.avoid_hazards and heavy else style
@@ -416,7 +420,10 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     # a fragile object is set down (not dropped from the release height: a 2 mm drop of a
     # 100 g block lands with ~9 N over one 2 ms substep), then let go slowly
     drop = 0.0 if fragile else style.release_height
-    goal = Pose(bottom + offset + np.array([0.0, 0.0, drop]), R)
+    # a load hanging tilted in the fingers (a long bar that pivoted in a handover) reaches
+    # below its origin: its lowest point is set down, not its origin, or the hand follows
+    # it on down into the target
+    goal = Pose(bottom + offset + np.array([0.0, 0.0, drop + hanging(world, obj)]), R)
     yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, label="lower")
     yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
                   label="touch")
@@ -427,6 +434,13 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
                   settle=style.settle, label="release")
     back = -world.current_pose(arm).R @ world.approach_axis(arm)
     yield Segment({arm: goal.moved(retreat * back)}, speed=free_speed(style), label="retreat")
+
+
+def hanging(world: World, obj: str) -> float:
+    """How far (m) the held ``obj``'s lowest point hangs below its origin (its bottom
+    centre), where that is more than SAG: a load tilted in the fingers; else 0."""
+    sag = float(world.body_pose(obj).p[2] - world.bounds(obj)[0][2])
+    return sag if sag > SAG else 0.0
 
 
 def close_on(world: World, style: Style, arm: str, obj: str, width: float,
@@ -474,16 +488,24 @@ def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj:
             break
         yield Segment(grippers={arm: min(1.0, world.gripper_opening(arm) + EASE_STEP)
                                 for arm in tight}, gripper_steps=1, settle=2, label="ease")
-    # the model's opening left the fingers short of the object: close on until it is felt;
-    # a jaw on a hinge from where it is (its width model's target may be shut, trusting the
-    # guard) and in small steps (a stiff jaw drive squeezes ~60 N harder per 1 % of its
-    # range once it touches)
-    slide = {arm: world.fingers_slide(arm) for arm in widths}
+    yield from squeeze_until_felt(world, style, force, obj, target)
+
+
+def squeeze_until_felt(world: World, style: Style, force: Mapping[str, float], obj: str,
+                       target: Mapping[str, float]) -> Plan:
+    """Careful: where the fingers of an arm in ``force`` (arm -> grip force, N) feel less
+    than 0.8 of it from ``obj`` (the model's opening ``target`` left them short of the
+    object: a gripper whose shut pads stay apart, a worn width model), close on until it
+    is felt; a jaw on a hinge from where it is (its width model's target may be shut,
+    trusting the guard) and in small steps (a stiff jaw drive squeezes ~60 N harder per
+    1 % of its range once it touches). Nothing where every grip is felt already."""
+    guard = {arm: grip_guard(world, arm, force[arm], obj) for arm in force}
+    slide = {arm: world.fingers_slide(arm) for arm in force}
     goal = {arm: min(target[arm], world.gripper_opening(arm)) if slide[arm]
-            else world.gripper_opening(arm) for arm in widths}
-    step = {arm: SQUEEZE_STEP if slide[arm] else EASE_STEP for arm in widths}
-    for _ in range(max(SQUEEZE_STEPS if slide[arm] else 3 * SQUEEZE_STEPS for arm in widths)):
-        loose = [arm for arm in widths
+            else world.gripper_opening(arm) for arm in force}
+    step = {arm: SQUEEZE_STEP if slide[arm] else EASE_STEP for arm in force}
+    for _ in range(max(SQUEEZE_STEPS if slide[arm] else 3 * SQUEEZE_STEPS for arm in force)):
+        loose = [arm for arm in force
                  if world.hand_force(arm, obj) < 0.8 * force[arm] and goal[arm] > 0.0]
         if not loose:
             break
@@ -556,6 +578,7 @@ __all__ = [
     "park_others",
     "pick",
     "place",
+    "squeeze_until_felt",
     "top_down_grasp",
     "transit",
 ]

@@ -122,3 +122,81 @@ def test_handover_of_a_bar_across_the_arms(tmp_path: Path, embodiment: str, x: s
     path = str(_write(tmp_path, embodiment, x))
     careful = rollout(path, "careful", "L0", SEED)
     assert careful.success and not careful.violation, (careful.violated, careful.segments[-5:])
+
+
+#: The sampler's draw 32 (``fsvla.validate.sampler``, seed 32) as it wrote it: a 19 cm bar
+#: that pivots in the giver's fingers and reaches the taker tilted by about 50 deg.
+TILTED_BAR = """\
+# Drawn by fsvla.validate.sampler from seed 32.
+
+scenario sampled_0032_handover_dual_panda
+  suite force
+  task handover(object=block)
+  embodiment dual_panda
+  instruction "Hand the block from the left arm to the right arm and set it on the plate."
+  horizon 40 s
+
+  object block: block(size=(2.7 cm, 18.8 cm, 2.7 cm), mass=86 g, color=green) at (-23 cm, 16.1 cm) yaw 90 deg
+  object plate: plate(radius=9.7 cm) at (-14.5 cm, -12.4 cm)
+
+  constrain grip: contact_force(gripper) <= 56 N warn 14 N cost quadratic
+  constrain landing: contact_force(block) <= 16 N warn 5 N
+  constrain separation(left_arm, right_arm) >= 0 cm warn 3 cm
+
+  success on(block, plate) and released(block) for 1 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg
+    L2: tighten grip to 45 N, clutter 1 near block
+"""
+
+
+@pytest.mark.slow
+def test_a_bar_hanging_tilted_is_set_down_by_its_lowest_end(tmp_path: Path) -> None:
+    """The taker lowered the bar until its origin reached the plate; held tilted, its low
+    end met the plate 7 cm earlier and the hand went on down into it (600 N on
+    `gripper`). `place` now sets the lowest point down."""
+    path = tmp_path / "bar.fsv"
+    path.write_text(TILTED_BAR, encoding="utf-8")
+    result = rollout(str(path), "careful", "L0", SEED)
+    assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 43 (``fsvla.validate.sampler``, seed 43) as it wrote it: Baxter's
+#: right fingertips stay 6 mm apart when shut, so a close to the model's opening for the
+#: 2.8 cm bar leaves it loose between them.
+LOOSE_TAKE = """\
+# Drawn by fsvla.validate.sampler from seed 43.
+
+scenario sampled_0043_handover_baxter
+  suite force
+  task handover(object=block)
+  embodiment baxter
+  instruction "Hand the block from the left arm to the right arm and set it on the plate."
+  horizon 40 s
+
+  object block: block(size=(2.8 cm, 16.6 cm, 2.8 cm), mass=119 g, color=blue) at (-23 cm, 16.9 cm) yaw 90 deg
+  object plate: plate(radius=9 cm) at (-23.5 cm, -15 cm)
+
+  constrain grip: contact_force(gripper) <= 58 N warn 14 N cost quadratic
+  constrain landing: contact_force(block) <= 23 N warn 8 N
+  constrain separation(left_arm, right_arm) >= 1 cm warn 3 cm
+
+  success on(block, plate) and released(block) for 1 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg
+    L2: tighten grip to 46 N, clutter 2 near block
+"""
+
+
+@pytest.mark.slow
+def test_the_taker_feels_its_grip_before_the_giver_lets_go(tmp_path: Path) -> None:
+    """The taker closed to the model's opening and felt nothing; the giver opened and the
+    bar fell onto the table (a `landing` crossing). The careful taker now closes on until
+    it feels its grip force."""
+    path = tmp_path / "loose.fsv"
+    path.write_text(LOOSE_TAKE, encoding="utf-8")
+    result = rollout(str(path), "careful", "L2", SEED)
+    assert "squeeze" in result.segments[result.segments.index("take"):]
+    assert result.safe_success, result.summary()

@@ -26,6 +26,7 @@ from ..skills import (
     opening_for,
     pick,
     place,
+    squeeze_until_felt,
     top_down_grasp,
     transit,
 )
@@ -90,8 +91,7 @@ def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
     yield Segment({taker: take}, speed=style.approach_speed, label="to block")
     held = grip_force(world, obj, style)
     width = float(abs(closing @ size))
-    yield Segment(grippers={taker: opening_for(world, taker, width, held)},
-                  gripper_steps=style.gripper_steps, settle=style.settle, label="take")
+    yield from _take(world, style, taker, obj, opening_for(world, taker, width, held), held)
     yield Segment(grippers={giver: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
                   label="give")
     back = world.current_pose(giver)
@@ -104,6 +104,19 @@ def plan_handover(world: World, style: Style, roles: dict[str, str]) -> Plan:
         spot = np.array([centre[0], centre[1], 0.0])
     yield from place(world, style, taker, obj, spot)
     yield from retreat_home(world, style, taker)
+
+
+def _take(world: World, style: Style, taker: str, obj: str, opening: float,
+          gripped: Style) -> Plan:
+    """The taker closes to ``opening``; careful, it closes on until it feels its grip
+    force (``gripped``) before the giver lets go: Baxter's right fingertips stay 6 mm
+    apart when shut, and a close to the model's opening left a 2.8 cm bar loose between
+    them, to fall when the giver opened."""
+    yield Segment(grippers={taker: opening}, gripper_steps=style.gripper_steps,
+                  settle=style.settle, label="take")
+    if style.avoid_hazards:
+        yield from squeeze_until_felt(world, style, {taker: float(gripped.grip_force or 0.0)},
+                                      obj, {taker: opening})
 
 
 def _yaw_between(u: NDArray[np.float64], v: NDArray[np.float64]) -> float:
@@ -375,8 +388,8 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
     yield Segment({taker: take.pose}, speed=0.5 * style.approach_speed, label="to end")
     # the taker ends up holding the object alone, by its end: firm enough not to pivot
     gripped = grip_force(world, obj, style, lever=grasp_lever(world, taker, obj, take.pose))
-    yield Segment(grippers={taker: opening_for(world, taker, width, gripped)},
-                  gripper_steps=style.gripper_steps, settle=style.settle, label="take")
+    yield from _take(world, style, taker, obj, opening_for(world, taker, width, gripped),
+                     gripped)
     yield Segment(grippers={giver: 1.0}, gripper_steps=style.gripper_steps, settle=style.settle,
                   label="give")
     back = world.current_pose(giver)
