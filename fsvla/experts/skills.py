@@ -56,9 +56,9 @@ SLOW_CLOSE = 0.005
 #: How far (m) beyond a pose, away from the arm's base, the arm must still reach for the
 #: pose to count as inside the reach rather than at its edge.
 REACH_SLACK = 0.05
-#: How far (m) a held load's lowest point may hang below its origin before :func:`place`
-#: sets that point down instead of the origin (a bar handed over and held a little askew,
-#: 1-1.2 cm, is set down as it always was).
+#: How far (m) a held load's lowest point may hang below its origin before
+#: ``place(by_lowest=True)`` sets that point down instead of the origin (a bar handed over
+#: and held a little askew, 1-1.2 cm, is set down as it always was).
 SAG = 0.02
 #: Height of the hand above its tool centre point (m), for clearing obstacles beneath it.
 HAND_RADIUS = 0.06
@@ -396,16 +396,19 @@ def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
 
 def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.float64],
           rotation: NDArray[np.float64] | None = None, retreat: float = 0.1,
-          release_gap: float | None = None) -> Plan:
+          release_gap: float | None = None, by_lowest: bool = False) -> Plan:
     """Carry the held ``obj`` so that its origin (bottom centre) lands at ``bottom``,
     lower it (slowly when careful), open, and back off. ``release_gap``: open only until
     each finger is that far (m) from the object (default: fully). Fingers that end near
     the simulator's contact distance (2 cm: a 4 cm object in an 8 cm hand) drop in and
-    out of contact as the hand backs off, which reads as grasping it again."""
+    out of contact as the hand backs off, which reads as grasping it again. ``by_lowest``:
+    a load that hangs more than SAG below its origin is set down by its lowest point (a
+    bar held by its end; a knife held by its handle instead lies down as the hand lowers
+    on, turning in the fingers, and is not raised)."""
     R = world.current_pose(arm).R if rotation is None else rotation
     offset = R @ held_offset(world, arm, obj)
     goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
-    below = float(offset[2]) + 0.03 + hanging(world, obj)
+    below = float(offset[2]) + 0.03 + (hanging(world, obj) if by_lowest else 0.0)
     heavy = float(world.asset(obj).mass) > LIGHT_LOAD
     carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
         if style.avoid_hazards and heavy else style
@@ -420,10 +423,11 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     # a fragile object is set down (not dropped from the release height: a 2 mm drop of a
     # 100 g block lands with ~9 N over one 2 ms substep), then let go slowly
     drop = 0.0 if fragile else style.release_height
-    # a load hanging tilted in the fingers (a long bar that pivoted in a handover) reaches
-    # below its origin: its lowest point is set down, not its origin, or the hand follows
-    # it on down into the target
-    goal = Pose(bottom + offset + np.array([0.0, 0.0, drop + hanging(world, obj)]), R)
+    # ``by_lowest``: a load hanging tilted in the fingers (a bar held by its end, which
+    # pivoted in a handover) reaches below its origin: its lowest point is set down, not
+    # its origin, or the hand follows it on down into the target
+    sag = hanging(world, obj) if by_lowest else 0.0
+    goal = Pose(bottom + offset + np.array([0.0, 0.0, drop + sag]), R)
     yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, label="lower")
     yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
                   label="touch")

@@ -402,7 +402,7 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
     spot = (place_point(world, style, obj, support) if support is not None
             else np.array([meet.middle[0], meet.middle[1], 0.0]))
     # let go with the fingers 1 cm clear: no contact flicker that reads as a new grasp
-    yield from place(world, style, taker, obj, spot, release_gap=0.01)
+    yield from place(world, style, taker, obj, spot, release_gap=0.01, by_lowest=True)
     yield from retreat_home(world, style, taker)
 
 
