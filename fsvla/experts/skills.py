@@ -425,7 +425,8 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     drop = 0.0 if fragile else style.release_height
     # ``by_lowest``: a load hanging tilted in the fingers (a bar held by its end, which
     # pivoted in a handover) reaches below its origin: its lowest point is set down, not
-    # its origin, or the hand follows it on down into the target
+    # its origin, or the hand follows it on down into the target (measured again: the
+    # load may have turned further on the way)
     sag = hanging(world, obj) if by_lowest else 0.0
     goal = Pose(bottom + offset + np.array([0.0, 0.0, drop + sag]), R)
     yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, label="lower")
@@ -543,6 +544,16 @@ def held_offset(world: World, arm: str, obj: str) -> NDArray[np.float64]:
     return tcp.R.T @ (tcp.p - world.body_pose(obj).p)
 
 
+def leaning_frame(world: World, arm: str, point: NDArray[np.float64],
+                  lean: float) -> NDArray[np.float64]:
+    """The hand over ``point`` pointing down but leaning by ``lean`` (rad) out from the
+    arm's base (negative: back toward it), its fingers closing level across the lean: the
+    one way a five-joint arm tips its hand, and how a short arm reaches far and low."""
+    out = horizontal(point - world.base_position(arm))
+    return world.grasp_frame(arm, np.cos(abs(lean)) * DOWN + np.sin(lean) * out,
+                             np.cross(UP, out))
+
+
 def top_down_grasp(world: World, arm: str, centre: NDArray[np.float64],
                    closing: NDArray[np.float64], width: float) -> Grasp:
     R = world.grasp_frame(arm, DOWN, closing)
@@ -576,6 +587,7 @@ __all__ = [
     "grip_guard",
     "held_offset",
     "horizontal",
+    "leaning_frame",
     "load_reach",
     "nearest_arm",
     "opening_for",

@@ -9,7 +9,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..motion import Guard, Pose, Segment
-from ..skills import DOWN, UP, Plan, branch_for_path, horizontal, nearest_arm, transit
+from ..skills import DOWN, UP, Plan, branch_for_path, leaning_frame, nearest_arm, transit
 from ..style import Style
 from ..world import World, box_distance
 from .common import HAND_HALF_LENGTH, retreat_home
@@ -145,14 +145,8 @@ def _leaning_frame(world: World, arm: str, top: np.ndarray,
     pressing far out and low: an SO-101 36 cm from its base), the hand leaning out from
     the base, or back toward it, by the least of LEANS that is; its fingers close across
     the lean, so that they stay level. None if none is."""
-    out = horizontal(top - world.base_position(arm))
-    across = np.cross(UP, out)
-    for lean in np.deg2rad(LEANS):
-        approach = np.cos(abs(lean)) * DOWN + np.sin(lean) * out
-        R = world.grasp_frame(arm, approach, across)
-        if followed(R):
-            return R
-    return None
+    return next((R for R in (leaning_frame(world, arm, top, float(lean))
+                             for lean in np.deg2rad(LEANS)) if followed(R)), None)
 
 
 #: How far above the pressed top (m) the hand's body is measured for clearance.

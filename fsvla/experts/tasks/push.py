@@ -13,6 +13,7 @@ from ..skills import (
     branch_for_path,
     force_watched,
     horizontal,
+    leaning_frame,
     nearest_arm,
     transit,
 )
@@ -60,8 +61,7 @@ def _push_frame(world: World, arm: str, behind: NDArray[np.float64],
     across = np.cross(UP, direction)
     frames = [world.grasp_frame(arm, DOWN, np.cos(t) * across + np.sin(t) * direction)
               for t in np.deg2rad([0.0, 45.0, -45.0, 90.0])]
-    radial = horizontal(behind - world.base_position(arm))
-    frames += [world.grasp_frame(arm, np.cos(t) * DOWN + np.sin(t) * radial, np.cross(UP, radial))
+    frames += [leaning_frame(world, arm, behind, float(t))
                for t in np.deg2rad([20.0, 40.0, 60.0, 80.0])]
     path = (behind, behind + travel * direction)
     for R in frames:
