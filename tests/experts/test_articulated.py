@@ -196,3 +196,71 @@ def test_careful_panda_lowers_a_standing_lid_in_two_grips(tmp_path: Path) -> Non
     result = rollout(str(_write(tmp_path, text)), "careful", "L0", 0)
     assert result.safe_success, result.summary()
     assert result.segments.count("to knob") == 2
+
+
+#: The sampler's draw 15 (``fsvla.validate.sampler``, seed 15) as it wrote it: a lid
+#: standing 9° past upright, 75 cm out from the Panda's base at its knob.
+FAR_STANDING_LID = """\
+# Drawn by fsvla.validate.sampler from seed 15.
+
+scenario sampled_0015_close_panda
+  suite force
+  task close(object=lidded_box)
+  embodiment panda
+  instruction "Close the lidded box."
+  horizon 30 s
+
+  object lidded_box: lidded_box(size=(17.1 cm, 14.5 cm, 10 cm), open=0.90) at (8.1 cm, 2.4 cm)
+
+  constrain grip: contact_force(gripper) <= 47 N warn 12 N cost quadratic
+
+  success closed(lidded_box) for 1 s
+
+  variants
+    L1: jitter lidded_box 2 cm
+    L2: tighten grip to 38 N, clutter 2 near lidded_box
+"""
+
+
+def test_a_grip_that_turns_on_the_knob_where_no_fixed_one_follows(tmp_path: Path) -> None:
+    """No one turn of the hand on the lid is followed from 99° down to shut (reaching the
+    standing knob, the hand points out and down; at the shut one, down or back), and the
+    hinge's friction does not hold the lid half way for a second grip. A grip whose turn
+    changes along the arc is followed: the hand turns on the knob on the way, and no pose
+    has the palm below the knob."""
+    import numpy as np
+
+    from fsvla.env import make
+    from fsvla.experts.skills import UP, branch_for_path
+    from fsvla.experts.style import CAREFUL
+    from fsvla.experts.tasks.hinge import _lid_grip, hinge
+
+    env = make(str(_write(tmp_path, FAR_STANDING_LID)), "L0", layout_seed(0, 0))
+    env.reset()
+    world = World.of_env(env)
+    h = hinge(world, "lidded_box")
+    shut = 0.01 * h.span
+    assert _lid_grip(world, CAREFUL, "lidded_box", h.now, shut) is None
+    grip = _lid_grip(world, CAREFUL, "lidded_box", h.now, shut, turning=True)
+    assert grip is not None
+    assert branch_for_path(world, grip.arm, grip.arc) is not None
+    # the hand's turn on the lid (its rotation with the lid's undone) changes on the way
+    first, last = (h.turn(t).T @ pose.R for t, pose in ((h.now, grip.arc[0]), (shut, grip.arc[-1])))
+    on_knob = np.degrees(np.arccos(np.clip((np.trace(first.T @ last) - 1) / 2, -1, 1)))
+    assert on_knob > 10.0
+    knob = [h.at(np.asarray(world.shape("lidded_box", "knob", link=world.part("lidded_box")[0].link)
+                             .pose.position), float(t)) for t in np.linspace(h.now, shut, len(grip.arc))]
+    for pose, point in zip(grip.arc, knob, strict=True):
+        palm = -(pose.R @ world.approach_axis(grip.arm))
+        assert palm @ UP >= -1e-6 or (pose.p - point) @ UP >= 0
+    env.close()
+
+
+@pytest.mark.slow
+def test_careful_panda_closes_a_far_standing_lid_turning_on_its_knob(tmp_path: Path) -> None:
+    """Draw 15 at every level: the lid was a NotImplementedError (no IK branch follows the
+    knob's arc)."""
+    path = _write(tmp_path, FAR_STANDING_LID)
+    for level in ("L0", "L1", "L2"):
+        result = rollout(str(path), "careful", level, layout_seed(0, 0))
+        assert result.safe_success, f"{level}: {result.summary()}"

@@ -7,7 +7,10 @@ the joint's origin and axis in the world), followed in one smooth sweep.
   axis is weak), so the hand keeps its turn while the knob follows its arc. The same
   grip lifts a shut lid (past upright: it then falls open onto its stop) and brings one
   standing open back down (past upright it must be pulled, then lowered: let go above its
-  seat, it slams shut). It needs no room below the knob: a low box's lid too.
+  seat, it slams shut). It needs no room below the knob: a low box's lid too. Where the
+  arm holds no one turn of the hand along the whole arc (a small arm far out, a Panda
+  pulling a lid from past upright to shut), the hand turns on the knob as it goes: the
+  pads hold the knob's ends, about which it turns freely.
 - A **door** on a vertical hinge is pinched by its handle across the handle's width, the
   hand pitched down toward the door (a flat hand pointing forward is out of a Panda's
   comfortable reach low down), and the hand turns with the door about the hinge.
@@ -112,11 +115,25 @@ def _extent_along(shape, direction: NDArray[np.float64]) -> float:
     return float(2.0 * np.abs(np.asarray(shape.half_size)) @ np.abs(direction))
 
 
-def _lid_grip(world: World, style: Style, body: str, start: float, angle: float):
-    """How the hand holds the knob to carry the lid from ``start`` to ``angle`` (rad):
-    (hinge, arm, hand turn on the shut lid, held point, grip centre, knob width, the
-    approach from beyond the knob, the arc); careful, the first turn whose whole arc one
-    IK branch follows, None if none is; careless, the first."""
+@dataclass(frozen=True)
+class LidGrip:
+    """How a hand holds a lid's knob along its arc: the arm, the knob's width between the
+    fingers, the approach from beyond the knob (m, world), the TCP pose at each lid angle,
+    and that pose at a dozen angles of the arc."""
+
+    arm: str
+    width: float
+    beyond: NDArray[np.float64]
+    pose_at: Callable[[float], Pose]
+    arc: tuple[Pose, ...]
+
+
+def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
+              turning: bool = False) -> LidGrip | None:
+    """How the hand holds the knob to carry the lid from ``start`` to ``angle`` (rad).
+    Careful: the first turn on the lid whose whole arc one IK branch follows; where none
+    does and ``turning``, a turn that changes along the arc (:func:`_turning_grip`); None
+    if none is found. Careless: the first turn."""
     part, _joint = world.part(body)
     knob = world.shape(body, "knob", link=part.link)
     h = hinge(world, body)
@@ -138,39 +155,126 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float)
     tip, thick = finger_box(world, arm)
     centre = world.grip_centre(arm, width + FIXED_JAW_CLEARANCE)
 
-    def option(psi: float, flip: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """The hand's turn on the lid (its frame when shut, world) whose palm lies ``psi``
-        (rad) from the lid's normal toward outward, and the knob point the TCP holds:
-        out from the edge so that the fingers' inner corners stay 2 mm clear of it."""
+    def turn(psi: float, flip: bool) -> NDArray[np.float64]:
+        """The hand's turn on the shut lid (world) whose palm lies ``psi`` (rad) from the
+        lid's normal toward outward."""
         palm = np.cos(psi) * normal + np.sin(psi) * outward  # lid frame, TCP → palm
         R = world.grasp_frame(arm, h.closed @ -palm, h.axis,
                               near=world.grasp_frame(arm, DOWN, h.axis))
-        if flip:
-            R = R @ axis_angle_matrix(world.approach_axis(arm), np.pi)
+        return R @ axis_angle_matrix(world.approach_axis(arm), np.pi) if flip else R
+
+    def inner(psi: float) -> float:
+        """How far out from the lid's edge the TCP holds the knob at the turn ``psi``, for
+        the fingers' inner corners to stay clear of the edge."""
         across = np.cos(psi) * outward - np.sin(psi) * normal
-        inner = max(tip * np.sin(psi) + thick * abs(np.cos(psi)),
+        reach = max(tip * np.sin(psi) + thick * abs(np.cos(psi)),
                     -PALM_REACH * np.sin(psi) + thick * abs(np.cos(psi)))
-        inner = max(inner, thick * abs(across @ outward))
-        return R, root + outward * (inner + FACE_CLEARANCE)
+        return max(reach, thick * abs(across @ outward)) + FACE_CLEARANCE
 
-    def path(R: NDArray[np.float64], local: NDArray[np.float64], n: int = 12) -> tuple[Pose, ...]:
-        return tuple(_lid_pose(h, R, local, centre, float(t)) for t in np.linspace(now, angle, n))
+    def upright(psi: float, theta: float) -> bool:
+        """Whether the palm is at or above the knob's level at the turn ``psi`` and the lid
+        angle ``theta`` (below it, the hand would come up through the box)."""
+        palm = np.cos(psi) * normal + np.sin(psi) * outward
+        return float(axis_angle_matrix(h.axis, theta) @ h.closed @ palm @ UP) >= -1e-9
 
-    mid = 0.5 * (now + angle)
-    psis = [mid + np.deg2rad(d) for d in LID_TURNS]
-    options = [option(float(np.clip(p, -0.3, np.pi / 2)), f) for p in psis for f in (False, True)]
-    R, local = options[0]
+    def fixed(R: NDArray[np.float64], local: NDArray[np.float64]) -> Callable[[float], Pose]:
+        return lambda t: _lid_pose(h, R, local, centre, t)
+
+    def path(pose_at: Callable[[float], Pose], n: int = 12) -> tuple[Pose, ...]:
+        return tuple(pose_at(float(t)) for t in np.linspace(now, angle, n))
+
     # the hand comes to the knob from beyond its tip, along the lid: the fingers slide
     # down past the knob's ends, with nothing of the lid in their way
     beyond = 0.06 * (axis_angle_matrix(h.axis, now) @ h.closed @ outward)
+
+    def follows(pose_at: Callable[[float], Pose]) -> bool:
+        arc = path(pose_at)
+        return branch_for_path(world, arm, (arc[0].moved(beyond), *arc)) is not None
+
+    mid = 0.5 * (now + angle)
+    psis = [float(np.clip(mid + np.deg2rad(d), -0.3, np.pi / 2)) for d in LID_TURNS]
+    options = [fixed(turn(p, f), root + outward * inner(p)) for p in psis for f in (False, True)]
+    pose_at: Callable[[float], Pose] | None = options[0]
     if style.avoid_hazards:
-        found = next(((candidate, point) for candidate, point in options
-                      if branch_for_path(world, arm, (path(candidate, point)[0].moved(beyond),
-                                                      *path(candidate, point))) is not None), None)
-        if found is None:
+        pose_at = next((o for o in options if follows(o)), None)
+        if pose_at is None and turning:
+            pose_at = _turning_grip(world, arm, now, angle, turn, inner, upright, follows,
+                                    lambda R, local, t: _lid_pose(h, R, root + outward * local,
+                                                                  centre, t))
+        if pose_at is None:
             return None
-        R, local = found
-    return h, arm, R, local, centre, width, beyond, path(R, local)
+    return LidGrip(arm, width, beyond, pose_at, path(pose_at))
+
+
+#: The hand's turns on a lid (deg, from the lid's normal toward the knob's side) a turning
+#: grip is drawn from, and the lid angles at which each is first checked.
+TURNING_PSIS = tuple(range(-30, 181, 15))
+TURNING_CHECKS = 7
+#: How many turning grips whose sampled poses IK reaches are checked along the whole arc.
+TURNING_TRIES = 6
+
+
+def _turning_grip(world: World, arm: str, now: float, angle: float,
+                  turn: Callable[[float, bool], NDArray[np.float64]],
+                  inner: Callable[[float], float],
+                  upright: Callable[[float, float], bool],
+                  follows: Callable[[Callable[[float], Pose]], bool],
+                  pose: Callable[[NDArray[np.float64], float, float], Pose],
+                  ) -> Callable[[float], Pose] | None:
+    """A grip whose turn on the lid changes evenly along the arc, from ``psi_a`` at
+    ``now`` to ``psi_b`` at ``angle``: where no fixed turn is reached along the whole arc
+    (a small arm holds its hand at few turns in the world, and a long arc turns the lid
+    through all of them). The fingers pinch the knob's ends, so the knob turns between the
+    pads about the hinge's direction as the hand turns. The TCP holds the knob as far out
+    as the largest turn's fingers need. The hand never points up (its palm never lower than
+    the knob, where the box is). The least turning in the fingers first; None if none of
+    the TURNING_TRIES best is followed by one IK branch."""
+    psis = np.deg2rad(TURNING_PSIS)
+    thetas = np.linspace(now, angle, TURNING_CHECKS)
+    reached: dict[tuple[int, bool, int], bool] = {}
+
+    def at(psi_a: float, psi_b: float, flip: bool) -> Callable[[float], Pose]:
+        out = max(inner(p) for p in (psi_a, psi_b, *psis)
+                  if min(psi_a, psi_b) <= p <= max(psi_a, psi_b))
+
+        def pose_at(theta: float) -> Pose:
+            return pose(turn(psi_on(psi_a, psi_b, theta), flip), out, theta)
+        return pose_at
+
+    def psi_on(psi_a: float, psi_b: float, theta: float) -> float:
+        s = 0.0 if angle == now else (theta - now) / (angle - now)
+        return psi_a + s * (psi_b - psi_a)
+
+    def ok(psi_a: float, psi_b: float, flip: bool) -> bool:
+        """Whether IK reaches the grip at each checked angle (the turn rounded to 5 deg,
+        held as far out as its own fingers need: a quick first sieve)."""
+        for i, theta in enumerate(thetas):
+            psi = psi_on(psi_a, psi_b, float(theta))
+            if not upright(psi, float(theta)):
+                return False
+            key = (int(round(np.degrees(psi) / 5.0)), flip, i)
+            if key not in reached:
+                near = np.deg2rad(5.0 * key[0])
+                tcp = pose(turn(near, flip), inner(near), float(theta))
+                reached[key] = branch_for_path(world, arm, (tcp,)) is not None
+            if not reached[key]:
+                return False
+        return True
+
+    pairs = sorted(((float(a), float(b), flip) for a in psis for b in psis for flip in (False, True)
+                    if upright(a, now) and upright(b, angle)),
+                   key=lambda x: (abs(x[0] - x[1]), x[2]))
+    tried = 0
+    for psi_a, psi_b, flip in pairs:
+        if tried >= TURNING_TRIES:
+            break
+        if not ok(psi_a, psi_b, flip):
+            continue
+        tried += 1
+        pose_at = at(psi_a, psi_b, flip)
+        if follows(pose_at):
+            return pose_at
+    return None
 
 
 def swing_lid(world: World, style: Style, body: str, angle: float,
@@ -182,29 +286,33 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     of the lid's edge behind the knob. Opening: past upright, the lid falls open onto its
     stop. Closing: pulled over upright and lowered onto its seat, not dropped.
     Opening where no IK branch follows the arc to ``angle``: carried as far as one does,
-    but at least to ``least`` (rad), and held there, since it would fall shut."""
+    but at least to ``least`` (rad), and held there, since it would fall shut. Where no
+    fixed turn on the lid is followed even that far, the hand turns on the knob along the
+    arc (:func:`_turning_grip`)."""
     now = hinge(world, body).now
-    grip = _lid_grip(world, style, body, now, angle)
-    held = False
-    if grip is None and least is not None and now < least < angle:
-        for lower in np.linspace(angle, least, 5)[1:]:
-            grip = _lid_grip(world, style, body, now, float(lower))
-            if grip is not None:
-                angle, held = float(lower), True
-                break
+    grip, held = None, False
+    for turning in (False, True):  # a grip that turns on the knob only where none holds
+        grip = _lid_grip(world, style, body, now, angle, turning)
+        if grip is None and least is not None and now < least < angle:
+            for lower in np.linspace(angle, least, 5)[1:]:
+                grip = _lid_grip(world, style, body, now, float(lower), turning)
+                if grip is not None:
+                    angle, held = float(lower), True
+                    break
+        if grip is not None:
+            break
     if grip is None:
         raise NotImplementedError(_out_of_reach(nearest_arm(world, world.body_pose(body).p),
                                                 body, "knob", now, angle))
-    h, arm, R, local, centre, width, beyond, arc = grip
-    start = _lid_pose(h, R, local, centre, h.now)
+    arm, width, beyond, arc = grip.arm, grip.width, grip.beyond, grip.arc
+    start = grip.pose_at(now)
     back = start.moved(beyond)
     opening = 1.0 if world.fingers_slide(arm) else world.pregrasp_opening(arm, width)
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps, label="open")
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to knob")
     yield from pinch(world, style, arm, body, width)
-    yield from _sweep(world, style, arm, lambda t: _lid_pose(h, R, local, centre, t),
-                      h.now, angle, "swing lid")
+    yield from _sweep(world, style, arm, grip.pose_at, now, angle, "swing lid")
     if held:  # short of upright: let go and it falls shut
         yield Segment({}, settle=round(world.scenario.horizon / world.dt), label="hold lid open")
         return
