@@ -252,7 +252,7 @@ def _turning_grip(world: World, arm: str, now: float, angle: float,
             psi = psi_on(psi_a, psi_b, float(theta))
             if not upright(psi, float(theta)):
                 return False
-            key = (int(round(np.degrees(psi) / 5.0)), flip, i)
+            key = (round(float(np.degrees(psi)) / 5.0), flip, i)
             if key not in reached:
                 near = np.deg2rad(5.0 * key[0])
                 tcp = pose(turn(near, flip), inner(near), float(theta))
