@@ -244,9 +244,33 @@ def reach_handle(world: World, arm: str, obj: str, handle: str, back: float = 0.
     return handle_grasp(world, arm, obj, handle)
 
 
+def _side_handles(world: World, arm: str, obj: str) -> list[Grasp]:
+    """A body with flat side handles (a pot) taken by one hand: from above, the fingers
+    closing along the handle (one inside the wall, the other beyond the handle's end), so
+    that the pads' push holds the body's weight hanging to one side (fingers closing
+    across the handle would hold it by friction alone, and the body tips down out of
+    them); by the handle nearer the arm's base first. The body's bounds where it has no
+    handles, or none fits between the fingers."""
+    pose = world.body_pose(obj)
+    base = world.base_position(arm)
+    out: list[tuple[float, Grasp]] = []
+    for shape in world.asset(obj).collision:
+        if not shape.name.startswith("handle") or shape.type != "box":
+            continue
+        centre = world.to_world(obj, shape.pose.position)
+        radial = horizontal(centre - pose.p)
+        half = np.asarray(shape.half_size, dtype=np.float64)
+        width = float(2.0 * np.abs(pose.R.T @ radial) @ half)
+        if width + HANDLE_SPARE > world.max_width(arm):
+            continue
+        out.append((float(np.linalg.norm((centre - base)[:2])),
+                    top_down_grasp(world, arm, centre, radial, width)))
+    return [g for _, g in sorted(out, key=lambda item: item[0])] or _generic(world, arm, obj)
+
+
 _MAKERS = {
     "glass": _cylinder, "bottle": _cylinder, "mug": _mug, "vase": _cylinder,
-    "bowl": _cylinder, "kettle": _mug, "block": _block, "knife": _knife,
+    "bowl": _cylinder, "kettle": _mug, "block": _block, "knife": _knife, "pot": _side_handles,
 }
 
 __all__ = ["HANDLE_PITCHES", "choose", "grasps", "handle_grasp", "reach_handle"]

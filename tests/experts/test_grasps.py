@@ -1,0 +1,73 @@
+"""One hand lifting a pot: by a side handle, the fingers closing along it (one inside the
+wall, one beyond the handle's end), not across the pot's bounds."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fsvla.env import make
+from fsvla.experts import rollout
+from fsvla.experts.grasps import grasps
+from fsvla.experts.skills import horizontal
+from fsvla.experts.world import World
+from fsvla.run.plan import layout_seed
+
+pytestmark = pytest.mark.sim
+
+POT = """\
+scenario lift_pot
+  suite force
+  task lift(object=pot)
+  embodiment {embodiment}
+  instruction "Lift the pot."
+  horizon 30 s
+
+  object pot: pot(radius=8 cm, height=10 cm, mass=250 g) at {at}
+
+  constrain grip: contact_force(gripper) <= 40 N warn 10 N
+
+  success lifted(pot) for 1 s
+"""
+
+
+def _write(tmp_path: Path, embodiment: str, at: str) -> Path:
+    path = tmp_path / "pot.fsv"
+    path.write_text(POT.format(embodiment=embodiment, at=at), encoding="utf-8")
+    return path
+
+
+def test_a_pot_is_taken_by_its_nearer_handle_along_it(tmp_path: Path) -> None:
+    env = make(str(_write(tmp_path, "panda", "(5 cm, 5 cm)")), "L0", layout_seed(0, 0))
+    env.reset()
+    world = World.of_env(env)
+    arm = world.arm_names[0]
+    found = grasps(world, arm, "pot")
+    assert len(found) == 2  # one per handle
+    pot = world.body_pose("pot").p
+    first = found[0]
+    handle = min((s for s in world.asset("pot").collision if s.name.startswith("handle")),
+                 key=lambda s: float(np.linalg.norm(world.to_world("pot", s.pose.position)
+                                                    - world.base_position(arm))))
+    centre = world.to_world("pot", handle.pose.position)
+    radial = horizontal(centre - pot)
+    closing = first.pose.R @ world.finger_axis(arm)
+    assert abs(float(closing @ radial)) > 0.99  # the fingers close along the handle
+    assert first.approach[2] < -0.99  # from above
+    assert np.allclose(first.pose.p[:2], centre[:2], atol=1e-6)
+    # the span from the pot's inner wall to the handle's end, inside what the hand opens
+    assert first.width == pytest.approx(2 * float(np.abs(world.body_pose("pot").R.T @ radial)
+                                                  @ np.asarray(handle.half_size)))
+    assert first.width < world.max_width(arm)
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("embodiment", "at"), [("panda", "(5 cm, 5 cm)"),
+                                                ("baxter", "(-15 cm, 5 cm)")])
+def test_one_hand_lifts_a_pot_by_a_handle(tmp_path: Path, embodiment: str, at: str) -> None:
+    """It was a grasp across the pot's bounds, wider than the hand opens: never lifted."""
+    result = rollout(str(_write(tmp_path, embodiment, at)), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
