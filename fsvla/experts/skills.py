@@ -324,7 +324,7 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
 
 #: How far (m) an idle arm moves its hand away from the working arm, at most, when a
 #: `separation` limit watches the two.
-PARK_OUT = 0.2
+PARK_OUT = 0.35
 #: How far (m) it rises as it moves away: the working arm reaches in below it.
 PARK_UP = 0.08
 
