@@ -1,0 +1,50 @@
+"""Skills shared by the task plans: an idle arm parked out of the working arm's way where
+a `separation` limit keeps the arms apart."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from fsvla.experts import rollout
+from fsvla.run.plan import layout_seed
+
+pytestmark = pytest.mark.sim
+
+#: The sampler's draw 52 (``fsvla.validate.sampler``, seed 52) as it wrote it: Baxter stacks
+#: a block from its left side onto one below its right hand, the arms kept 10 cm apart.
+ACROSS_BAXTER = """\
+# Drawn by fsvla.validate.sampler from seed 52.
+
+scenario sampled_0052_stack_baxter
+  suite collaborative
+  task stack(object=block, target=other_block)
+  embodiment baxter
+  instruction "Stack the block on the other block."
+  horizon 30 s
+
+  object block: block(size=(2.7 cm, 2.9 cm, 3.6 cm), mass=55 g, color=yellow) at (-27.8 cm, 19.5 cm) yaw 1 deg
+  object other_block: block(size=(5.9 cm, 5.9 cm, 5.9 cm), mass=59 g, color=red) at (-26.7 cm, -21.7 cm) yaw -30 deg
+
+  constrain arms: separation(left_arm, right_arm) >= 10 cm warn 3 cm cost quadratic
+  constrain separation(left_gripper, right_gripper) >= 0 warn 2 cm
+
+  success on(block, other_block) and released(block) for 0.5 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg, jitter other_block 2 cm
+    L2: tighten arms to 11 cm, clutter 2 near other_block
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", ["L0", "L1", "L2"])
+def test_the_idle_arm_parks_out_of_a_carry_across_the_table(tmp_path: Path, level: str) -> None:
+    """Parked 20 cm away, the idle right arm stood in the carrying arm's way: `arms`
+    crossed at every level."""
+    path = tmp_path / "stack.fsv"
+    path.write_text(ACROSS_BAXTER, encoding="utf-8")
+    result = rollout(str(path), "careful", level, layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+    assert "park" in result.segments
