@@ -10,6 +10,7 @@ from ..style import Style
 from ..world import World
 from .cavity import place_in_cavity
 from .common import HAND_BOTTOM, HAND_HALF_LENGTH, required_fraction, retreat_home
+from .hinge import knob_pinch_fits, swing_lid
 from .lid import LID_PAST_VERTICAL, lift_lid
 from .open_close import part_handle, plan_move_part
 from .pick_place import plan_pick_place
@@ -135,7 +136,13 @@ def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan
         angle = max(LID_PAST_VERTICAL, (need + 0.07) * span)
     else:
         angle = max(0.3, need - 0.2) * span
-    yield from lift_lid(world, style, target, min(angle, 0.95 * span))
+    angle = min(angle, 0.95 * span)
+    if _knob_height(world, target) < KNOB_LIFTED_FROM_BELOW and knob_pinch_fits(world, target):
+        # too low for the hand upright under the knob (it meets the table): pinched by its
+        # ends, as `open` does, and past upright (held short of it, it would keep the hand)
+        yield from swing_lid(world, style, target, angle)
+    else:
+        yield from lift_lid(world, style, target, angle)
     arm = nearest_arm(world, world.body_pose(obj).p)
     yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
     body = world.asset(target).links[0].name
@@ -150,6 +157,21 @@ def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan
         bottom[2] = float(hi[2])
     yield from place(world, style, arm, obj, bottom, rotation=R, retreat=0.1)
     yield from retreat_home(world, style, arm)
+
+
+#: The least height (m) of a lid's knob above the table at which the hand lifts it from
+#: below (:func:`~.lid.lift_lid`: the upright Panda hand under it is 21 cm tall); a lower
+#: one is pinched by its ends (:func:`~.hinge.swing_lid`).
+KNOB_LIFTED_FROM_BELOW = 0.11
+
+
+def _knob_height(world: World, body: str) -> float:
+    """How high (m) above the table the bottom of a lid's knob is now."""
+    part, _joint = world.part(body)
+    knob = world.shape(body, "knob", link=part.link)
+    link = world.link_pose(body, part.link)
+    centre = link.p + link.R @ np.asarray(knob.pose.position, dtype=np.float64)
+    return float(centre[2] - np.abs(link.R[2, :]) @ np.asarray(knob.half_size, dtype=np.float64))
 
 
 __all__ = ["plan_insert"]
