@@ -137,3 +137,43 @@ def test_a_low_lid_is_pinched_by_its_knob_not_lifted_from_below(tmp_path):
     result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
     assert "swing lid" in result.segments and "under knob" not in result.segments
+
+
+#: The sampler's draw 82 (``fsvla.validate.sampler``, seed 82) as it wrote it: Baxter's left
+#: arm lifts the lid, its right arm carries the block into the box, the arms 8 cm apart.
+BLOCK_UNDER_LID_BAXTER = """\
+# Drawn by fsvla.validate.sampler from seed 82.
+
+scenario sampled_0082_insert_baxter
+  suite collaborative
+  task insert(object=block, target=lidded_box)
+  embodiment baxter
+  instruction "Put the block into the lidded box."
+  horizon 50 s
+
+  object block: block(size=(3 cm, 3.3 cm, 4.6 cm), mass=77 g, color=yellow) at (-26.1 cm, -7.9 cm) yaw -1 deg
+  object lidded_box: lidded_box(size=(17.8 cm, 14.5 cm, 8.6 cm)) at (5.9 cm, 6.2 cm)
+
+  constrain arms: separation(left_arm, right_arm) >= 8 cm warn 3 cm cost quadratic
+  constrain separation(left_gripper, right_gripper) >= 0 warn 2 cm
+
+  success inside(block, lidded_box) and released(block) for 0.5 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg, jitter lidded_box 2 cm
+    L2: tighten arms to 9 cm, clutter 1 near lidded_box
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", ["L0", "L1", "L2"])
+def test_the_arm_that_lifted_the_lid_moves_out_of_the_carry(tmp_path, level):
+    """The lid's arm stayed over the box the other arm carried to: `arms` crossed at
+    every level."""
+    from fsvla.run.plan import layout_seed
+
+    path = tmp_path / "insert.fsv"
+    path.write_text(BLOCK_UNDER_LID_BAXTER, encoding="utf-8")
+    result = rollout(str(path), "careful", level, layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+    assert result.segments.count("park") == 2  # at the start, and after the lid

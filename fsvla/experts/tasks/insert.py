@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import grasps
-from ..skills import DOWN, UP, Plan, held_offset, nearest_arm, pick, place
+from ..skills import DOWN, UP, Plan, held_offset, nearest_arm, park_others, pick, place
 from ..style import Style
 from ..world import World
 from .cavity import place_in_cavity
@@ -144,6 +144,8 @@ def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan
     else:
         yield from lift_lid(world, style, target, angle)
     arm = nearest_arm(world, world.body_pose(obj).p)
+    # the arm that lifted the lid stands over the box the other carries to: out of its way
+    yield from park_others(world, style, arm, (world.body_pose(obj).p, world.body_pose(target).p))
     yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
     body = world.asset(target).links[0].name
     floor = world.shape(target, "bottom", link=body)
