@@ -264,3 +264,44 @@ def test_careful_panda_closes_a_far_standing_lid_turning_on_its_knob(tmp_path: P
     for level in ("L0", "L1", "L2"):
         result = rollout(str(path), "careful", level, layout_seed(0, 0))
         assert result.safe_success, f"{level}: {result.summary()}"
+
+
+#: The sampler's draw 14 (``fsvla.validate.sampler``, seed 14) as it wrote it: a Z1 opening a
+#: lid whose knob stands 1.2 cm out from its edge.
+Z1_LID = """\
+# Drawn by fsvla.validate.sampler from seed 14.
+
+scenario sampled_0014_open_z1
+  suite force
+  task open(object=lidded_box)
+  embodiment z1
+  instruction "Open the lidded box."
+  horizon 30 s
+
+  object lidded_box: lidded_box(size=(14.1 cm, 11.3 cm, 7.8 cm)) at (21.1 cm, -12 cm)
+
+  constrain grip: contact_force(gripper) <= 44 N warn 11 N cost quadratic
+
+  success opened(lidded_box, fraction=0.6) for 0.5 s
+
+  variants
+    L1: jitter lidded_box 2 cm
+    L2: tighten grip to 35 N, clutter 1 near lidded_box
+"""
+
+
+@pytest.mark.slow
+def test_a_pinch_that_closes_on_nothing_says_so(tmp_path: Path) -> None:
+    """The Z1's jaws are so thick that the fingers clearing the lid's edge hold the knob
+    4 cm out, beyond its end: the swing went on with nothing in hand, a quiet failure."""
+    from fsvla.env import make
+
+    env = make(str(_write(tmp_path, Z1_LID)), "L0", layout_seed(0, 0))
+    expert = make_expert(env, "careful")
+    observation, _ = env.reset()
+    expert.reset(None)
+    with pytest.raises(NotImplementedError, match="fingers closed on nothing at `lidded_box`'s knob"):
+        for _ in range(400):
+            for action in expert.act(observation):
+                observation, *_ = env.step(action)
+    env.close()

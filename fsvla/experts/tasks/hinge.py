@@ -57,6 +57,8 @@ LID_TURNS = (0.0, -15.0, 15.0, -30.0, 30.0, -45.0, 45.0)
 #: How far (m) the fingers reach back from the TCP toward the palm, for the clearance of
 #: their inner corners from the lid's edge (a Panda's: 4.5 cm).
 PALM_REACH = 0.045
+#: The least force (N) a careful pinch must feel from the part to have it in hand.
+FELT = 0.5
 #: How much wider (m) than the held knob the gripper must open.
 PINCH_SPARE = 0.012
 
@@ -312,6 +314,11 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to knob")
     yield from pinch(world, style, arm, body, width)
+    if style.avoid_hazards and world.hand_force(arm, body) < FELT:
+        raise NotImplementedError(
+            f"the careful expert's fingers closed on nothing at `{body}`'s knob: the pinch "
+            f"that keeps `{arm}`'s fingers clear of the lid's edge holds the knob beyond "
+            f"its end (the fingers are thicker than the knob stands out)")
     yield from _sweep(world, style, arm, grip.pose_at, now, angle, "swing lid")
     if held:  # short of upright: let go and it falls shut
         yield Segment({}, settle=round(world.scenario.horizon / world.dt), label="hold lid open")
