@@ -201,8 +201,8 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
         pose_at = next((o for o in options if follows(o)), None)
         if pose_at is None and turning:
             pose_at = _turning_grip(world, arm, now, angle, turn, inner, upright, follows,
-                                    lambda R, local, t: _lid_pose(h, R, root + outward * local,
-                                                                  centre, t))
+                                    lambda R, out, t: _lid_pose(h, R, root + outward * out,
+                                                                centre, t))
         if pose_at is None:
             return None
     return LidGrip(arm, width, beyond, pose_at, path(pose_at))
@@ -230,7 +230,9 @@ def _turning_grip(world: World, arm: str, now: float, angle: float,
     pads about the hinge's direction as the hand turns. The TCP holds the knob as far out
     as the largest turn's fingers need. The hand never points up (its palm never lower than
     the knob, where the box is). The least turning in the fingers first; None if none of
-    the TURNING_TRIES best is followed by one IK branch."""
+    the TURNING_TRIES best is followed by one IK branch. ``pose(R, out, theta)``: the TCP
+    with the hand's turn ``R`` on the shut lid, holding the knob ``out`` (m) beyond the
+    lid's edge, the lid at ``theta``."""
     psis = np.deg2rad(TURNING_PSIS)
     thetas = np.linspace(now, angle, TURNING_CHECKS)
     reached: dict[tuple[int, bool, int], bool] = {}
