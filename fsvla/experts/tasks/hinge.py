@@ -133,9 +133,9 @@ class LidGrip:
 def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
               turning: bool = False) -> LidGrip | None:
     """How the hand holds the knob to carry the lid from ``start`` to ``angle`` (rad).
-    Careful: the first turn on the lid whose whole arc one IK branch follows; where none
-    does and ``turning``, a turn that changes along the arc (:func:`_turning_grip`); None
-    if none is found. Careless: the first turn."""
+    Careful: the first fixed turn on the lid whose whole arc one IK branch follows; with
+    ``turning``, instead a turn that changes along the arc (:func:`_turning_grip`); None
+    if none is found. Careless: the first fixed turn."""
     part, _joint = world.part(body)
     knob = world.shape(body, "knob", link=part.link)
     h = hinge(world, body)
@@ -198,8 +198,8 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
     options = [fixed(turn(p, f), root + outward * inner(p)) for p in psis for f in (False, True)]
     pose_at: Callable[[float], Pose] | None = options[0]
     if style.avoid_hazards:
-        pose_at = next((o for o in options if follows(o)), None)
-        if pose_at is None and turning:
+        pose_at = None if turning else next((o for o in options if follows(o)), None)
+        if turning:
             pose_at = _turning_grip(world, arm, now, angle, turn, inner, upright, follows,
                                     lambda R, out, t: _lid_pose(h, R, root + outward * out,
                                                                 centre, t))
@@ -295,7 +295,7 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     arc (:func:`_turning_grip`)."""
     now = hinge(world, body).now
     grip, held = None, False
-    for turning in (False, True):  # a grip that turns on the knob only where none holds
+    for turning in (False, True):  # a grip that turns on the knob only where no fixed one holds
         grip = _lid_grip(world, style, body, now, angle, turning)
         if grip is None and least is not None and now < least < angle:
             for lower in np.linspace(angle, least, 5)[1:]:
