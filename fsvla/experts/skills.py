@@ -53,6 +53,8 @@ EASE_STEPS = 12
 #: of its range a control step (a soft finger drive swinging shut faster meets the object
 #: with a squeeze of 50-60 N in one step, before the guard can feel it).
 SLOW_CLOSE = 0.005
+#: How close (m) the tips of a jaw on a hinge may come to what a grasped object stands on.
+TIP_GAP = 0.004
 #: How far (m) beyond a pose, away from the arm's base, the arm must still reach for the
 #: pose to count as inside the reach rather than at its edge.
 REACH_SLACK = 0.05
@@ -378,6 +380,8 @@ def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
         grasp = Grasp(Pose(grasp.pose.p - shift, grasp.pose.R), grasp.width, grasp.approach)
     yield Segment(grippers={arm: world.pregrasp_opening(arm, grasp.width)},
                   gripper_steps=style.gripper_steps, label="open")
+    if not world.fingers_slide(arm):
+        grasp = jaws_clear_of_support(world, arm, obj, grasp)
     pre = grasp.pose.moved(-pre_distance * grasp.approach)
     if grasp.approach[2] < -0.7:  # from above: no higher than the arm reaches
         top = reach_ceiling(world, arm, grasp.pose.p, grasp.pose.R, float(pre.p[2]))
@@ -392,6 +396,22 @@ def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
         - grasp.pose.p[2]))
     yield Segment({arm: grasp.pose.moved(lift * UP)}, speed=free_speed(style),
                   label="lift")
+
+
+def jaws_clear_of_support(world: World, arm: str, obj: str, grasp: Grasp) -> Grasp:
+    """A grasp from above raised, where it must be, so that the jaws as they are now
+    (opened for it) stay :data:`TIP_GAP` above the bottom of ``obj``, what it stands on: a
+    fixed jaw reaches past the TCP (the Z1's by 2 cm), and a grasp low on a small block
+    would drive it into the table."""
+    if grasp.approach[2] > -0.7:
+        return grasp
+    floor = float(world.bounds(obj)[0][2]) + world.hand_reach(arm) * -float(grasp.approach[2]) \
+        + TIP_GAP
+    if grasp.pose.p[2] >= floor:
+        return grasp
+    p = grasp.pose.p.copy()
+    p[2] = floor
+    return Grasp(Pose(p, grasp.pose.R), grasp.width, grasp.approach)
 
 
 def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.float64],
@@ -587,6 +607,7 @@ __all__ = [
     "grip_guard",
     "held_offset",
     "horizontal",
+    "jaws_clear_of_support",
     "leaning_frame",
     "load_reach",
     "nearest_arm",

@@ -102,3 +102,48 @@ def test_baxter_lifts_a_pot_by_handles_wider_than_its_gripper(tmp_path: Path) ->
     path.write_text(POT, encoding="utf-8")
     result = rollout(str(path), "careful")
     assert result.safe_success, result.summary()
+
+
+LOW_BLOCK_Z1 = """\
+scenario lift_low_block_z1
+  suite force
+  task lift(object=block)
+  embodiment z1
+  instruction "Lift the purple block."
+  horizon 10 s
+
+  object block: block(size=(4.5 cm, 4.7 cm, 3.1 cm), mass=167 g, color=purple) at (6 cm, -10 cm) yaw 24 deg
+
+  constrain grip: contact_force(gripper) <= 58 N warn 14 N
+
+  success lifted(block, by=5 cm) for 0.5 s
+"""
+
+
+def test_the_z1s_fixed_jaw_stays_off_the_table_beside_a_low_block(tmp_path: Path) -> None:
+    """The Z1's fixed jaw reaches 2 cm past its TCP: a grasp low on a 3 cm block put its
+    tip on the table (280 N on the hand before the jaws closed)."""
+    from fsvla.env import make
+    from fsvla.experts.policy import make_expert
+
+    path = tmp_path / "low_block.fsv"
+    path.write_text(LOW_BLOCK_Z1, encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    expert = make_expert(env, "careful")
+    obs, _ = env.reset()
+    expert.reset(None)
+    world = World.of_env(env)
+    arm = world.arm_names[0]
+    assert world.hand_reach(arm) > 0.015  # the premise: the jaw reaches past the TCP
+    step, labels, pressed = 0, set(), 0.0
+    while "preclose" not in labels and step < 400:
+        for action in expert.act(obs):
+            label = expert.labels[step] if step < len(expert.labels) else ""
+            obs, *_ = env.step(action)
+            step += 1
+            labels.add(label)
+            if label in ("approach", "reach"):  # the jaws open beside the block: no touch
+                pressed = max(pressed, world.hand_force(arm))
+    env.close()
+    assert {"approach", "reach", "preclose"} <= labels
+    assert pressed < 0.5, f"the hand pressed with {pressed:.1f} N on its way down"
