@@ -282,7 +282,7 @@ def _turning_grip(world: World, arm: str, now: float, angle: float,
 
 
 def swing_lid(world: World, style: Style, body: str, angle: float,
-              least: float | None = None) -> Plan:
+              least: float | None = None, missed: Callable[[], Plan] | None = None) -> Plan:
     """Pinch a lid's knob by its ends (the fingers closing along the hinge) and carry it
     along its arc to ``angle`` (rad), the hand turning with the lid; let go and rise.
     The hand's turn on the lid is the one that keeps it nearest pointing down over the
@@ -292,7 +292,8 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     Opening where no IK branch follows the arc to ``angle``: carried as far as one does,
     but at least to ``least`` (rad), and held there, since it would fall shut. Where no
     fixed turn on the lid is followed even that far, the hand turns on the knob along the
-    arc (:func:`_turning_grip`)."""
+    arc (:func:`_turning_grip`). A careful pinch that feels nothing from the knob (fingers
+    thicker than it stands out) lets go and runs ``missed`` instead, or says so."""
     now = hinge(world, body).now
     grip, held = None, False
     for turning in (False, True):  # a grip that turns on the knob only where no fixed one holds
@@ -317,6 +318,10 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to knob")
     yield from pinch(world, style, arm, body, width)
     if style.avoid_hazards and world.hand_force(arm, body) < FELT:
+        if missed is not None:
+            yield from _let_go(world, style, arm, opening, 0.05)
+            yield from missed()
+            return
         raise NotImplementedError(
             f"the careful expert's fingers closed on nothing at `{body}`'s knob: the pinch "
             f"that keeps `{arm}`'s fingers clear of the lid's edge holds the knob beyond "

@@ -171,8 +171,9 @@ SWUNG_SHUT = 0.01
 
 def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
     """A drawer: pull its handle; a lid: pinch its knob by its ends and lift it past upright
-    (where it stays open) or as far as a requirement asks; a hinged door: pinch its handle
-    and swing it open past the fraction asked."""
+    (where it stays open) or as far as a requirement asks (where the careful pinch feels
+    nothing, or the knob is wider than the gripper opens: lift it from below); a hinged
+    door: pinch its handle and swing it open past the fraction asked."""
     body = roles["object"]
     part, joint = world.part(body)
     need = required_fraction(world, body)
@@ -183,7 +184,9 @@ def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
         angle = min(max(LID_PAST_VERTICAL, (need + 0.07) * span), 0.95 * span)
         if knob_pinch_fits(world, body):
             least = min((max(need, success_fraction(world, body)) + 0.07) * span, angle)
-            yield from swing_lid(world, style, body, angle, least)
+            # fingers too thick to hold the knob's ends lift it from below instead
+            yield from swing_lid(world, style, body, angle, least,
+                                 missed=lambda: lift_lid(world, style, body, angle))
         else:
             yield from lift_lid(world, style, body, angle)
     elif _handled_door(world, body):
