@@ -345,3 +345,38 @@ def test_careful_z1_opens_a_lid_its_jaws_cannot_pinch(tmp_path: Path) -> None:
     for level in ("L0", "L1", "L2"):
         result = rollout(str(path), "careful", level, layout_seed(0, 0))
         assert result.safe_success, f"{level}: {result.summary()}"
+
+
+#: The sampler's draw 47: Baxter opening a 36 cm cabinet's drawer 18 cm deep.
+BAXTER_DRAWER = """\
+# Drawn by fsvla.validate.sampler from seed 47.
+
+scenario sampled_0047_open_baxter
+  suite force
+  task open(object=drawer_cabinet)
+  embodiment baxter
+  instruction "Open the drawer cabinet."
+  horizon 30 s
+
+  object drawer_cabinet: drawer_cabinet(size=(35.6 cm, 34.8 cm, 23.1 cm), travel=17.8 cm) at (20.3 cm, -5.4 cm)
+
+  constrain grip: contact_force(gripper) <= 43 N warn 11 N cost quadratic
+  constrain separation(left_arm, right_arm) >= 1 cm warn 3 cm
+
+  success opened(drawer_cabinet, fraction=0.6) for 0.5 s
+
+  variants
+    L1: jitter drawer_cabinet 2 cm
+    L2: tighten grip to 34 N, clutter 2 near drawer_cabinet
+"""
+
+
+@pytest.mark.slow
+def test_careful_baxter_pulls_a_drawer_again_where_the_first_pull_fell_short(
+        tmp_path: Path) -> None:
+    """Draw 47 at every level: one pull left the drawer 58 % open (the handle slips in
+    Baxter's fingers, and the pull ends at the edge of its reach); 60 % is asked."""
+    path = _write(tmp_path, BAXTER_DRAWER)
+    for level in ("L0", "L1", "L2"):
+        result = rollout(str(path), "careful", level, layout_seed(0, 0))
+        assert result.safe_success, f"{level}: {result.summary()}"

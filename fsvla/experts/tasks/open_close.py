@@ -160,6 +160,10 @@ def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
     return R0
 
 
+#: A careful pull that leaves a drawer open by less than this (a fraction of its travel)
+#: past what is asked pulls again from where the handle is.
+REPULL_MARGIN = 0.03
+REPULLS = 2
 #: An open fraction below this is shut: there is nothing to close.
 SHUT = 0.02
 
@@ -179,7 +183,15 @@ def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
     need = required_fraction(world, body)
     span = joint.upper - joint.lower
     if _sliding(world, body):
-        yield from plan_move_part(world, style, body, max(0.8, need + 0.15))
+        target = max(0.8, need + 0.15)
+        yield from plan_move_part(world, style, body, target)
+        for _ in range(REPULLS):
+            if not style.avoid_hazards or world.open_fraction(body) >= max(
+                    need, success_fraction(world, body)) + REPULL_MARGIN:
+                break
+            # the handle slipped in the fingers, or the pull ended at the edge of the
+            # reach: take it again where it is now and pull on
+            yield from plan_move_part(world, style, body, target)
     elif _knob_lid(world, body):
         angle = min(max(LID_PAST_VERTICAL, (need + 0.07) * span), 0.95 * span)
         if knob_pinch_fits(world, body):
