@@ -181,13 +181,13 @@ def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
     body = roles["object"]
     part, joint = world.part(body)
     need = required_fraction(world, body)
+    asked = max(need, success_fraction(world, body))  # what must hold at the end
     span = joint.upper - joint.lower
     if _sliding(world, body):
         target = max(0.8, need + 0.15)
         yield from plan_move_part(world, style, body, target)
         for _ in range(REPULLS):
-            if not style.avoid_hazards or world.open_fraction(body) >= max(
-                    need, success_fraction(world, body)) + REPULL_MARGIN:
+            if not style.avoid_hazards or world.open_fraction(body) >= asked + REPULL_MARGIN:
                 break
             # the handle slipped in the fingers, or the pull ended at the edge of the
             # reach: take it again where it is now and pull on
@@ -195,14 +195,13 @@ def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
     elif _knob_lid(world, body):
         angle = min(max(LID_PAST_VERTICAL, (need + 0.07) * span), 0.95 * span)
         if knob_pinch_fits(world, body):
-            least = min((max(need, success_fraction(world, body)) + 0.07) * span, angle)
+            least = min((asked + 0.07) * span, angle)
             # fingers too thick to hold the knob's ends lift it from below instead
             yield from swing_lid(world, style, body, angle, least,
                                  missed=lambda: lift_lid(world, style, body, angle))
         else:
             yield from lift_lid(world, style, body, angle)
     elif _handled_door(world, body):
-        asked = max(need, success_fraction(world, body))
         yield from swing_door(world, style, body, min(asked + 0.12, 0.95) * span)
     else:
         raise NotImplementedError(_unsupported(body, part.name, joint.type, "open"))
