@@ -68,3 +68,77 @@ def test_the_push_is_made_with_a_turn_the_arm_follows(scenario: Path) -> None:
 def test_careful_expert_pushes_the_block_safely(scenario: Path) -> None:
     careful = rollout(str(scenario), "careful", "L0", SEED)
     assert careful.safe_success, (careful.violated, careful.segments[-5:])
+
+
+#: The sampler's draw 123 (``fsvla.validate.sampler``, seed 123): an SO-101 pushes a block
+#: 12 cm sideways, 35 cm out from its base. No one turn of its hand is held along the push
+#: (a five-joint arm turns its hand with the direction to its base), so it pushes in legs.
+FAR_SIDEWAYS = """\
+scenario far_sideways_push_so101
+  suite boundary
+  task push(object=block, target=other_block)
+  embodiment so101
+  instruction "Push the block to the block."
+  horizon 30 s
+
+  object block: block(size=(3.9 cm, 4.6 cm, 4.8 cm), mass=59 g, color=blue) at (14.8 cm, -3.7 cm) yaw 5 deg
+  object other_block: block(size=(3 cm, 3 cm, 1 cm), mass=194 g, color=orange) at (12.8 cm, 9.3 cm) yaw -23 deg
+  hazard edge: edge_zone(side=right, width=5 cm)
+    keep gripper outside 0 warn 2 cm
+
+  constrain geofence: edge_clearance(block) >= 3 cm warn 2 cm
+
+  success near(block, other_block, within=3 cm)
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg, jitter other_block 2 cm
+    L2: tighten geofence to 4 cm, clutter 1
+"""
+
+
+@pytest.fixture()
+def far_sideways(tmp_path: Path) -> Path:
+    path = tmp_path / "far_sideways.fsv"
+    path.write_text(FAR_SIDEWAYS, encoding="utf-8")
+    return path
+
+
+def test_a_push_no_one_turn_follows_is_made_in_legs_the_arm_follows(far_sideways: Path) -> None:
+    from fsvla.env import make
+    from fsvla.experts.motion import Pose
+    from fsvla.experts.skills import branch_for_path, nearest_arm
+    from fsvla.experts.tasks.push import _push_frame, _push_line, _push_route
+
+    env = make(str(far_sideways), "L0", SEED)
+    env.reset()
+    world = World.of_env(env)
+    start, goal = world.body_pose("block").p, world.body_pose("other_block").p
+    arm = nearest_arm(world, start)
+    behind, direction, travel = _push_line(world, arm, "block", start, goal)
+    assert _push_frame(world, arm, behind, direction, travel) is None
+    route = _push_route(world, arm, behind, direction, travel)
+    assert route is not None
+    pose_at, length, whole = route
+    assert 0.01 < length and not whole  # a first leg, short of the target
+    poses = tuple(pose_at(float(s)) for s in np.linspace(0.0, length, 6))
+    assert branch_for_path(world, arm, poses) is not None
+    # the hand leans out from the base, turning with the direction to it along the leg
+    outs = [horizontal_of(p.p - world.base_position(arm)) for p in poses]
+    approaches = [p.R @ world.approach_axis(arm) for p in poses]
+    for out, approach in zip(outs, approaches):
+        assert approach[2] < -0.5 and float(approach[:2] @ out[:2]) > 0.1
+    assert np.degrees(np.arccos(np.clip(outs[0] @ outs[-1], -1, 1))) > 2.0
+    env.close()
+
+
+def horizontal_of(v: np.ndarray) -> np.ndarray:
+    h = np.array([v[0], v[1], 0.0])
+    return h / np.linalg.norm(h)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", ["L0", "L1", "L2"])
+def test_the_so101_pushes_a_block_far_sideways_safely(far_sideways: Path, level: str) -> None:
+    careful = rollout(str(far_sideways), "careful", level, SEED)
+    assert careful.safe_success, (careful.violated, careful.segments)
+    assert careful.segments.count("hover") >= 2, careful.segments  # more than one leg

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -20,57 +22,164 @@ from ..skills import (
 from ..style import Style
 from ..world import World
 from .common import retreat_home
+from .lid import smooth_arc
 
 
 def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
-    """Push ``object`` over the table to ``target``'s centre with closed fingers."""
+    """Push ``object`` over the table to ``target``'s centre with closed fingers: in one
+    straight push where the arm follows all of it with one turn of the hand; else in legs,
+    the hand leaning out and turning with the direction to the base as it goes, each leg as
+    far as the arm follows it and the next from where the object is then."""
     obj, target = roles["object"], roles["target"]
-    start, goal = world.body_pose(obj).p, world.body_pose(target).p
-    arm = nearest_arm(world, start)
+    arm = nearest_arm(world, world.body_pose(obj).p)
+    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
+    for leg in range(PUSH_LEGS):
+        start, goal = world.body_pose(obj).p, world.body_pose(target).p
+        behind, direction, travel = _push_line(world, arm, obj, start, goal)
+        if leg and travel < LEG_DONE:
+            break
+        R = _push_frame(world, arm, behind, direction, travel)
+        route = None if R is not None else _push_route(world, arm, behind, direction, travel)
+        if route is None:
+            if R is not None or leg == 0:  # all the way (none followed at all: the first turn)
+                R = _push_frames(world, arm, behind, direction)[0] if R is None else R
+                yield from _push_straight(world, style, arm, obj, Pose(behind, R),
+                                          travel * direction)
+            break
+        planned, length, whole = route
+        yield from transit(world, style, arm, planned(0.0).moved(0.08 * UP), exclude=(obj,))
+        hover = planned(0.0).moved(HOVER * UP)
+        yield Segment({arm: hover}, speed=style.approach_speed, settle=style.settle,
+                      label="hover")
+        # the hand, leaning, stops off its command by a few millimetres, and far out by a
+        # centimetre or more (the arm sags; the five-joint arm's IK holds the turn of the
+        # hand before its place): the leg is commanded that much off, as measured at the
+        # hover above its start, as a camera-guided arm corrects its reach
+        error = hover.p - world.current_pose(arm).p
+        error *= min(1.0, MAX_CORRECTION / max(float(np.linalg.norm(error)), 1e-9))
+
+        def pose_at(s: float, planned=planned, error=error) -> Pose:
+            return planned(s).moved(error)
+
+        yield Segment({arm: pose_at(0.0)}, speed=style.approach_speed, label="down")
+        speed = style.contact_speed * (1 if style.avoid_hazards and force_watched(world, obj)
+                                       else 3)
+        yield from smooth_arc(world, style, arm, pose_at, 0.0, length, speed, "push")
+        yield Segment(settle=style.settle, label="push")
+        moved = float(np.linalg.norm((world.body_pose(obj).p - start)[:2]))
+        # off the object before the next leg: back from it, then up
+        end = world.current_pose(arm)
+        yield Segment({arm: end.moved(-LEG_BACK * direction)}, speed=style.approach_speed,
+                      label="back")
+        yield Segment({arm: end.moved(-LEG_BACK * direction + 0.05 * UP)},
+                      speed=style.approach_speed, label="up")
+        if whole or moved < LEG_DONE:
+            break
+    yield from retreat_home(world, style, arm)
+
+
+def _push_line(world: World, arm: str, obj: str, start: NDArray[np.float64],
+               goal: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    """Where the hand starts behind ``obj`` (TCP), the push direction and its length."""
     direction = horizontal(goal - start)
     lo, hi = world.bounds(obj)
     reach = 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2]) + 0.02
     height = lo[2] + 0.4 * (hi[2] - lo[2])
-    base = np.array([start[0], start[1], height]) - reach * direction
-    travel = float(np.linalg.norm((goal - start)[:2]))
-    behind = Pose(base, _push_frame(world, arm, base, direction, travel))
-    end = behind.moved(travel * direction)
-    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
     # a hand whose body reaches below its TCP (a Z1's) pushes higher, off the table:
     # measured on the shut hand, along its approach axis
     lowest = lo[2] + world.hand_reach(arm) + TABLE_GAP
-    if behind.p[2] < lowest:
-        lift = min(lowest, lo[2] + 0.7 * (hi[2] - lo[2])) - behind.p[2]
-        behind, end = behind.moved(lift * UP), end.moved(lift * UP)
+    if height < lowest:
+        height = min(lowest, lo[2] + 0.7 * (hi[2] - lo[2]))
+    behind = np.array([start[0], start[1], height]) - reach * direction
+    return behind, direction, float(np.linalg.norm((goal - start)[:2]))
+
+
+def _push_straight(world: World, style: Style, arm: str, obj: str, behind: Pose,
+                   push: NDArray[np.float64]) -> Plan:
     yield from transit(world, style, arm, behind.moved(0.08 * UP), exclude=(obj,))
     yield Segment({arm: behind}, speed=style.approach_speed, label="down")
     # careful, on an object a force limit watches: at contact speed (a rigid hand pushing
     # at three times that chatters, with one-step spikes of ~60 N)
     speed = style.contact_speed * (1 if style.avoid_hazards and force_watched(world, obj) else 3)
-    yield Segment({arm: end}, speed=speed,
-                  settle=style.settle, label="push")
-    yield from retreat_home(world, style, arm)
+    yield Segment({arm: behind.moved(push)}, speed=speed, settle=style.settle, label="push")
 
 
-def _push_frame(world: World, arm: str, behind: NDArray[np.float64],
-                direction: NDArray[np.float64], travel: float) -> NDArray[np.float64]:
-    """The hand's orientation for the push: pointing down, fingers closing across the push,
-    where the arm follows the whole push that way, else the first turn about the vertical
-    it does, then tipped out from the base (a five-joint arm turns its hand with the
-    direction to its base, and a short one reaches far only with its hand tipped out)."""
+def _push_frames(world: World, arm: str, behind: NDArray[np.float64],
+                 direction: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+    """The hand pointing down, fingers closing across the push, then turned about the
+    vertical; then tipped out from the base (a short arm reaches far only tipped out)."""
     across = np.cross(UP, direction)
     frames = [world.grasp_frame(arm, DOWN, np.cos(t) * across + np.sin(t) * direction)
               for t in np.deg2rad([0.0, 45.0, -45.0, 90.0])]
-    frames += [leaning_frame(world, arm, behind, float(t))
-               for t in np.deg2rad([20.0, 40.0, 60.0, 80.0])]
+    return frames + [leaning_frame(world, arm, behind, float(t)) for t in np.deg2rad(LEANS)]
+
+
+def _push_frame(world: World, arm: str, behind: NDArray[np.float64],
+                direction: NDArray[np.float64], travel: float) -> NDArray[np.float64] | None:
+    """The first of :func:`_push_frames` the arm holds along the whole push, None if none."""
     path = (behind, behind + travel * direction)
-    for R in frames:
+    for R in _push_frames(world, arm, behind, direction):
         if branch_for_path(world, arm, tuple(Pose(p, R) for p in path)) is not None:
             return R
-    return frames[0]
+    return None
+
+
+def _push_route(world: World, arm: str, behind: NDArray[np.float64],
+                direction: NDArray[np.float64], travel: float
+                ) -> tuple[Callable[[float], Pose], float, bool] | None:
+    """Where no one turn of the hand is held along the push (a five-joint arm turns its
+    hand with the direction to its base; far out, it reaches low only leaning out): the
+    hand leaning out by one of LEANS at each point, its fingers closing across the push
+    (its thin side leads) or else level across the lean (its wrist may not roll that far;
+    the fingers' side then leads, and the hand starts SIDE_STANDOFF farther back), and the
+    longest share of the push (of LEG_SHARES) the arm follows that way. (pose at distance s
+    along it, its length, whether it pushes all the way) or None."""
+    def maker(lean: float, across: bool) -> tuple[Callable[[float], Pose], float]:
+        back = 0.0 if across else SIDE_STANDOFF
+        first = behind - back * direction
+
+        def pose_at(s: float) -> Pose:
+            p = first + s * direction
+            out = horizontal(p - world.base_position(arm))
+            approach = np.cos(lean) * DOWN + np.sin(lean) * out
+            closing = np.cross(approach, direction) if across else np.cross(UP, out)
+            if np.linalg.norm(closing) < 1e-3:
+                closing = np.cross(UP, out)
+            return Pose(p, world.grasp_frame(arm, approach, closing / np.linalg.norm(closing)))
+        return pose_at, back
+
+    for share in LEG_SHARES:
+        if share * travel < LEG_DONE:
+            break
+        for across in (True, False):
+            for lean in np.deg2rad(LEANS):
+                pose_at, back = maker(float(lean), across)
+                length = share * travel + back
+                n = max(2, int(np.ceil(length / ROUTE_STEP)) + 1)
+                poses = tuple(pose_at(float(s)) for s in np.linspace(0.0, length, n))
+                if branch_for_path(world, arm, poses) is not None:
+                    return pose_at, length, share == 1.0
+    return None
 
 
 #: How far (m) the lowest point of the pushing hand stays above the table.
 TABLE_GAP = 0.008
+#: Leans (deg) of the hand out from pointing down, tried in turn.
+LEANS = (20.0, 40.0, 60.0, 80.0)
+#: A push in legs: at most PUSH_LEGS of them, each the longest of LEG_SHARES of what is
+#: left that the arm follows (checked every ROUTE_STEP, m); it stops once a leg moved the
+#: object less than LEG_DONE (m), or less than that is left; between legs the hand backs
+#: LEG_BACK (m) off the object and rises.
+PUSH_LEGS = 4
+LEG_SHARES = (1.0, 0.75, 0.5, 0.3, 0.15)
+ROUTE_STEP = 0.03
+LEG_DONE = 0.01
+LEG_BACK = 0.02
+#: Where a leg's hand stops above its start (m) to measure how far off its command it is,
+#: and the most (m) a leg's commands are moved to make up for it.
+HOVER = 0.03
+MAX_CORRECTION = 0.02
+#: How much farther back (m) a hand whose fingers close along the push starts.
+SIDE_STANDOFF = 0.02
 
 __all__ = ["plan_push"]
