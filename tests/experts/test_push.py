@@ -105,8 +105,7 @@ def far_sideways(tmp_path: Path) -> Path:
 
 def test_a_push_no_one_turn_follows_is_made_in_legs_the_arm_follows(far_sideways: Path) -> None:
     from fsvla.env import make
-    from fsvla.experts.motion import Pose
-    from fsvla.experts.skills import branch_for_path, nearest_arm
+    from fsvla.experts.skills import branch_for_path, horizontal, nearest_arm
     from fsvla.experts.tasks.push import _push_frame, _push_line, _push_route
 
     env = make(str(far_sideways), "L0", SEED)
@@ -123,17 +122,12 @@ def test_a_push_no_one_turn_follows_is_made_in_legs_the_arm_follows(far_sideways
     poses = tuple(pose_at(float(s)) for s in np.linspace(0.0, length, 6))
     assert branch_for_path(world, arm, poses) is not None
     # the hand leans out from the base, turning with the direction to it along the leg
-    outs = [horizontal_of(p.p - world.base_position(arm)) for p in poses]
+    outs = [horizontal(p.p - world.base_position(arm)) for p in poses]
     approaches = [p.R @ world.approach_axis(arm) for p in poses]
     for out, approach in zip(outs, approaches):
         assert approach[2] < -0.5 and float(approach[:2] @ out[:2]) > 0.1
     assert np.degrees(np.arccos(np.clip(outs[0] @ outs[-1], -1, 1))) > 2.0
     env.close()
-
-
-def horizontal_of(v: np.ndarray) -> np.ndarray:
-    h = np.array([v[0], v[1], 0.0])
-    return h / np.linalg.norm(h)
 
 
 @pytest.mark.slow
