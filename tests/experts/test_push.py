@@ -43,16 +43,22 @@ def scenario(tmp_path: Path) -> Path:
     return path
 
 
-def test_the_push_is_made_with_a_turn_the_arm_follows(scenario: Path) -> None:
+def reset_world(path: Path):
+    """The env of ``path`` at L0, reset, and the world the experts read from it."""
     from fsvla.env import make
+
+    env = make(str(path), "L0", SEED)
+    env.reset()
+    world = World.of_env(env)
+    return env, world, world.body_pose("block").p, world.body_pose("other_block").p
+
+
+def test_the_push_is_made_with_a_turn_the_arm_follows(scenario: Path) -> None:
     from fsvla.experts.motion import Pose
     from fsvla.experts.skills import DOWN, UP, branch_for_path, horizontal, nearest_arm
     from fsvla.experts.tasks.push import _push_frame
 
-    env = make(str(scenario), "L0", SEED)
-    env.reset()
-    world = World.of_env(env)
-    start, goal = world.body_pose("block").p, world.body_pose("other_block").p
+    env, world, start, goal = reset_world(scenario)
     direction = horizontal(goal - start)
     arm = nearest_arm(world, start)
     behind = np.array([start[0], start[1], 0.02]) - 0.04 * direction
@@ -104,14 +110,10 @@ def far_sideways(tmp_path: Path) -> Path:
 
 
 def test_a_push_no_one_turn_follows_is_made_in_legs_the_arm_follows(far_sideways: Path) -> None:
-    from fsvla.env import make
     from fsvla.experts.skills import branch_for_path, horizontal, nearest_arm
     from fsvla.experts.tasks.push import _push_frame, _push_line, _push_route
 
-    env = make(str(far_sideways), "L0", SEED)
-    env.reset()
-    world = World.of_env(env)
-    start, goal = world.body_pose("block").p, world.body_pose("other_block").p
+    env, world, start, goal = reset_world(far_sideways)
     arm = nearest_arm(world, start)
     behind, direction, travel = _push_line(world, arm, "block", start, goal)
     assert _push_frame(world, arm, behind, direction, travel) is None
