@@ -281,6 +281,24 @@ class World:
                 reach = max(reach, float(np.max((points - tcp.p) @ axis)))
         return reach
 
+    def hand_front(self, arm: str, R: NDArray[np.float64], direction: NDArray[np.float64],
+                   tcp: NDArray[np.float64], below: float) -> float:
+        """How far (m) the hand's collision hulls, as they are now but with the hand turned
+        to ``R`` and its TCP at ``tcp``, reach past the TCP along ``direction`` (world),
+        counting only what is lower than ``below`` (world z): the part of a pushing hand
+        that meets the object first."""
+        now = self.current_pose(arm)
+        front = 0.0
+        for link in self.hand_links(arm):
+            points = self.link_points(arm, link)
+            if points is None:
+                continue
+            placed = (points - now.p) @ now.R @ R.T + tcp  # into the TCP frame, then to R
+            low = placed[placed[:, 2] < below]
+            if len(low):
+                front = max(front, float(np.max((low - tcp) @ direction)))
+        return front
+
     def link_points(self, arm: str, link: str) -> NDArray[np.float64] | None:
         """The vertices of an arm link's collision hull where the link is now (world, m);
         None for a link without one."""

@@ -43,14 +43,15 @@ def scenario(tmp_path: Path) -> Path:
     return path
 
 
-def reset_world(path: Path):
-    """The env of ``path`` at L0, reset, and the world the experts read from it."""
+def reset_world(path: Path, obj: str = "block", target: str = "other_block"):
+    """The env of ``path`` at L0, reset, the world the experts read from it, and where the
+    pushed object and the target are."""
     from fsvla.env import make
 
     env = make(str(path), "L0", SEED)
     env.reset()
     world = World.of_env(env)
-    return env, world, world.body_pose("block").p, world.body_pose("other_block").p
+    return env, world, world.body_pose(obj).p, world.body_pose(target).p
 
 
 def test_the_push_is_made_with_a_turn_the_arm_follows(scenario: Path) -> None:
@@ -138,3 +139,65 @@ def test_the_so101_pushes_a_block_far_sideways_safely(far_sideways: Path, level:
     careful = rollout(str(far_sideways), "careful", level, SEED)
     assert careful.safe_success, (careful.violated, careful.segments)
     assert careful.segments.count("hover") >= 2, careful.segments  # more than one leg
+
+
+#: The sampler's draw 79: the Z1 pushes a mug. Its shut jaws are 8 cm wide, so the front
+#: of the hand, turned for the push, is 4 cm ahead of its TCP.
+WIDE_HAND = """\
+scenario wide_hand_push_z1
+  suite force
+  task push(object=mug, target=block)
+  embodiment z1
+  instruction "Push the mug to the block."
+  horizon 30 s
+
+  object mug: mug(radius=3.1 cm, height=8.6 cm, mass=147 g, color=orange) at (4.9 cm, 11.2 cm)
+  object block: block(size=(3 cm, 3 cm, 1 cm), mass=198 g, color=red) at (20.7 cm, -9 cm) yaw 6 deg
+
+  constrain grip: contact_force(gripper) <= 39 N warn 10 N cost quadratic
+  constrain landing: contact_force(mug) <= 14 N warn 5 N
+
+  success near(mug, block, within=3 cm)
+
+  variants
+    L1: jitter mug 2 cm, jitter block 2 cm
+    L2: tighten grip to 31 N, clutter 1 near block
+"""
+
+
+@pytest.fixture()
+def wide_hand(tmp_path: Path) -> Path:
+    path = tmp_path / "wide_hand.fsv"
+    path.write_text(WIDE_HAND, encoding="utf-8")
+    return path
+
+
+def test_the_hand_front_is_measured_on_its_hulls(wide_hand: Path, scenario: Path) -> None:
+    from fsvla.experts.skills import DOWN, UP, nearest_arm
+    from fsvla.experts.tasks.push import HAND_GAP, STANDOFF, _push_frame, _push_line
+
+    fronts = {}
+    for path, obj, target in ((wide_hand, "mug", "block"), (scenario, "block", "other_block")):
+        env, world, start, goal = reset_world(path, obj, target)
+        arm = nearest_arm(world, start)
+        behind, direction, travel = _push_line(world, arm, obj, start, goal)
+        chosen = _push_frame(world, arm, behind, direction, travel)
+        across = world.grasp_frame(arm, DOWN, np.cross(UP, direction))
+        fronts[path] = [world.hand_front(arm, R, direction, behind, world.top(obj))
+                        for R in (across, chosen)]
+        # only what is lower than ``below`` counts
+        assert world.hand_front(arm, chosen, direction, behind, -1.0) == 0.0
+        env.close()
+    # the Z1's jaws, fingers closing across the push, reach 4 cm ahead: it backs off
+    assert fronts[wide_hand][0] > STANDOFF + 0.01
+    # Baxter's hand turned so that its fingers lie along the push (its arm does not
+    # follow the push with them across) reaches farther ahead than with them across
+    across, turned = fronts[scenario]
+    assert turned > across + 0.01 and turned + HAND_GAP > STANDOFF
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", ["L0", "L1", "L2"])
+def test_the_z1_starts_its_push_with_its_jaws_clear_of_the_mug(wide_hand: Path, level: str) -> None:
+    careful = rollout(str(wide_hand), "careful", level, SEED)
+    assert careful.safe_success, (careful.violated, careful.segments)

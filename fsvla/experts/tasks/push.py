@@ -83,7 +83,7 @@ def _push_line(world: World, arm: str, obj: str, start: NDArray[np.float64],
     """Where the hand starts behind ``obj`` (TCP), the push direction and its length."""
     direction = horizontal(goal - start)
     lo, hi = world.bounds(obj)
-    reach = 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2]) + 0.02
+    reach = 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2]) + STANDOFF
     height = lo[2] + 0.4 * (hi[2] - lo[2])
     # a hand whose body reaches below its TCP (a Z1's) pushes higher, off the table:
     # measured on the shut hand, along its approach axis
@@ -96,6 +96,12 @@ def _push_line(world: World, arm: str, obj: str, start: NDArray[np.float64],
 
 def _push_straight(world: World, style: Style, arm: str, obj: str, behind: Pose,
                    push: NDArray[np.float64]) -> Plan:
+    # a hand whose body reaches farther ahead of its TCP than the standoff (the Z1's jaws,
+    # 8 cm wide) would come down onto the object: it starts that much farther back
+    direction = push / np.linalg.norm(push)
+    front = world.hand_front(arm, behind.R, direction, behind.p, world.top(obj))
+    back = max(0.0, front + HAND_GAP - STANDOFF)
+    behind, push = behind.moved(-back * direction), push + back * direction
     yield from transit(world, style, arm, behind.moved(0.08 * UP), exclude=(obj,))
     yield Segment({arm: behind}, speed=style.approach_speed, label="down")
     # careful, on an object a force limit watches: at contact speed (a rigid hand pushing
@@ -162,6 +168,10 @@ def _push_route(world: World, arm: str, behind: NDArray[np.float64],
     return None
 
 
+#: The TCP starts STANDOFF (m) behind the object, and the front of the hand at least
+#: HAND_GAP behind it.
+STANDOFF = 0.02
+HAND_GAP = 0.008
 #: How far (m) the lowest point of the pushing hand stays above the table.
 TABLE_GAP = 0.008
 #: Leans (deg) of the hand out from pointing down, tried in turn.
