@@ -112,12 +112,14 @@ def far_sideways(tmp_path: Path) -> Path:
 
 def test_a_push_no_one_turn_follows_is_made_in_legs_the_arm_follows(far_sideways: Path) -> None:
     from fsvla.experts.skills import branch_for_path, horizontal, nearest_arm
-    from fsvla.experts.tasks.push import _push_frame, _push_line, _push_route
+    from fsvla.experts.tasks.push import _off_the_table, _push_frame, _push_line, _push_route
 
     env, world, start, goal = reset_world(far_sideways)
     arm = nearest_arm(world, start)
-    behind, direction, travel = _push_line(world, arm, "block", start, goal)
-    assert _push_frame(world, arm, behind, direction, travel) is None
+    bounds = world.bounds("block")
+    line, direction, travel = _push_line(world, "block", start, goal, bounds)
+    assert _push_frame(world, arm, line, direction, travel) is None
+    behind = _off_the_table(world, arm, line, bounds)
     route = _push_route(world, arm, behind, direction, travel)
     assert route is not None
     pose_at, length, whole = route
@@ -180,7 +182,7 @@ def test_the_hand_front_is_measured_on_its_hulls(wide_hand: Path, scenario: Path
     for path, obj, target in ((wide_hand, "mug", "block"), (scenario, "block", "other_block")):
         env, world, start, goal = reset_world(path, obj, target)
         arm = nearest_arm(world, start)
-        behind, direction, travel = _push_line(world, arm, obj, start, goal)
+        behind, direction, travel = _push_line(world, obj, start, goal, world.bounds(obj))
         chosen = _push_frame(world, arm, behind, direction, travel)
         across = world.grasp_frame(arm, DOWN, np.cross(UP, direction))
         fronts[path] = [world.hand_front(arm, R, direction, behind, world.top(obj))

@@ -32,13 +32,22 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
     far as the arm follows it and the next from where the object is then."""
     obj, target = roles["object"], roles["target"]
     arm = nearest_arm(world, world.body_pose(obj).p)
+    # the first leg is laid out, and the one turn for the whole push chosen, on the line at
+    # 40 % of the object's height, where things are before the fingers close
+    bounds = world.bounds(obj)
+    start, goal = world.body_pose(obj).p, world.body_pose(target).p
+    line, direction, travel = _push_line(world, obj, start, goal, bounds)
+    R = _push_frame(world, arm, line, direction, travel)
     yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
     for leg in range(PUSH_LEGS):
-        start, goal = world.body_pose(obj).p, world.body_pose(target).p
-        behind, direction, travel = _push_line(world, arm, obj, start, goal)
-        if leg and travel < LEG_DONE:
-            break
-        R = _push_frame(world, arm, behind, direction, travel)
+        if leg:
+            bounds = world.bounds(obj)
+            start, goal = world.body_pose(obj).p, world.body_pose(target).p
+            line, direction, travel = _push_line(world, obj, start, goal, bounds)
+            if travel < LEG_DONE:
+                break
+            R = _push_frame(world, arm, line, direction, travel)
+        behind = _off_the_table(world, arm, line, bounds)  # measured on the shut hand
         route = None if R is not None else _push_route(world, arm, behind, direction, travel)
         if route is None:
             if R is not None or leg == 0:  # all the way (none followed at all: the first turn)
@@ -78,20 +87,28 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
     yield from retreat_home(world, style, arm)
 
 
-def _push_line(world: World, arm: str, obj: str, start: NDArray[np.float64],
-               goal: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
-    """Where the hand starts behind ``obj`` (TCP), the push direction and its length."""
+def _push_line(world: World, obj: str, start: NDArray[np.float64],
+               goal: NDArray[np.float64], bounds: tuple[NDArray[np.float64], NDArray[np.float64]]
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    """Where the hand starts behind ``obj`` (TCP), at 40 % of its height (``bounds``), the
+    push direction and its length."""
     direction = horizontal(goal - start)
-    lo, hi = world.bounds(obj)
+    lo, hi = bounds
     reach = 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2]) + STANDOFF
     height = lo[2] + 0.4 * (hi[2] - lo[2])
-    # a hand whose body reaches below its TCP (a Z1's) pushes higher, off the table:
-    # measured on the shut hand, along its approach axis
-    lowest = lo[2] + world.hand_reach(arm) + TABLE_GAP
-    if height < lowest:
-        height = min(lowest, lo[2] + 0.7 * (hi[2] - lo[2]))
     behind = np.array([start[0], start[1], height]) - reach * direction
     return behind, direction, float(np.linalg.norm((goal - start)[:2]))
+
+
+def _off_the_table(world: World, arm: str, point: NDArray[np.float64],
+                   bounds: tuple[NDArray[np.float64], NDArray[np.float64]]) -> NDArray[np.float64]:
+    """``point`` raised for a hand whose body reaches below its TCP (a Z1's), measured on
+    the hand as it is, along its approach axis: up to 70 % of the object's height."""
+    lo, hi = bounds
+    lowest = lo[2] + world.hand_reach(arm) + TABLE_GAP
+    if point[2] >= lowest:
+        return point
+    return point + (min(lowest, lo[2] + 0.7 * (hi[2] - lo[2])) - point[2]) * UP
 
 
 def _push_straight(world: World, style: Style, arm: str, obj: str, behind: Pose,
