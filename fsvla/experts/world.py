@@ -275,11 +275,14 @@ class World:
         tcp = self.current_pose(arm)
         axis = tcp.R @ self.approach_axis(arm)
         reach = 0.0
-        for link in self.hand_links(arm):
-            points = self.link_points(arm, link)
-            if points is not None:
-                reach = max(reach, float(np.max((points - tcp.p) @ axis)))
+        for points in self._hand_points(arm):
+            reach = max(reach, float(np.max((points - tcp.p) @ axis)))
         return reach
+
+    def _hand_points(self, arm: str) -> list[NDArray[np.float64]]:
+        """The vertices of each of the hand's collision hulls where they are now (world)."""
+        found = (self.link_points(arm, link) for link in self.hand_links(arm))
+        return [points for points in found if points is not None]
 
     def hand_front(self, arm: str, R: NDArray[np.float64], direction: NDArray[np.float64],
                    tcp: NDArray[np.float64], below: float) -> float:
@@ -289,10 +292,7 @@ class World:
         that meets the object first."""
         now = self.current_pose(arm)
         front = 0.0
-        for link in self.hand_links(arm):
-            points = self.link_points(arm, link)
-            if points is None:
-                continue
+        for points in self._hand_points(arm):
             placed = (points - now.p) @ now.R @ R.T + tcp  # into the TCP frame, then to R
             low = placed[placed[:, 2] < below]
             if len(low):

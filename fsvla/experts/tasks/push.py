@@ -49,9 +49,9 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
             R = _push_frame(world, arm, line, direction, travel)
         behind = _off_the_table(world, arm, line, bounds)  # measured on the shut hand
         route = None if R is not None else _push_route(world, arm, behind, direction, travel)
-        if route is None:
-            if R is not None or leg == 0:  # all the way (none followed at all: the first turn)
-                R = _push_frames(world, arm, behind, direction)[0] if R is None else R
+        if route is None:  # all the way with one turn (none followed at all: the first)
+            if leg == 0 or R is not None:
+                R = R if R is not None else _push_frames(world, arm, behind, direction)[0]
                 yield from _push_straight(world, style, arm, obj, Pose(behind, R),
                                           travel * direction)
             break
@@ -71,9 +71,8 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
             return planned(s).moved(error)
 
         yield Segment({arm: pose_at(0.0)}, speed=style.approach_speed, label="down")
-        speed = style.contact_speed * (1 if style.avoid_hazards and force_watched(world, obj)
-                                       else 3)
-        yield from smooth_arc(world, style, arm, pose_at, 0.0, length, speed, "push")
+        yield from smooth_arc(world, style, arm, pose_at, 0.0, length,
+                              _push_speed(world, style, obj), "push")
         yield Segment(settle=style.settle, label="push")
         moved = float(np.linalg.norm((world.body_pose(obj).p - start)[:2]))
         # off the object before the next leg: back from it, then up
@@ -121,10 +120,14 @@ def _push_straight(world: World, style: Style, arm: str, obj: str, behind: Pose,
     behind, push = behind.moved(-back * direction), push + back * direction
     yield from transit(world, style, arm, behind.moved(0.08 * UP), exclude=(obj,))
     yield Segment({arm: behind}, speed=style.approach_speed, label="down")
-    # careful, on an object a force limit watches: at contact speed (a rigid hand pushing
-    # at three times that chatters, with one-step spikes of ~60 N)
-    speed = style.contact_speed * (1 if style.avoid_hazards and force_watched(world, obj) else 3)
-    yield Segment({arm: behind.moved(push)}, speed=speed, settle=style.settle, label="push")
+    yield Segment({arm: behind.moved(push)}, speed=_push_speed(world, style, obj),
+                  settle=style.settle, label="push")
+
+
+def _push_speed(world: World, style: Style, obj: str) -> float:
+    """Careful, on an object a force limit watches: contact speed (a rigid hand pushing at
+    three times that chatters, with one-step spikes of ~60 N)."""
+    return style.contact_speed * (1 if style.avoid_hazards and force_watched(world, obj) else 3)
 
 
 def _push_frames(world: World, arm: str, behind: NDArray[np.float64],
