@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from itertools import pairwise
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,6 +25,9 @@ from fsvla.compiler.pose import matrix_to_quat, quat_to_matrix, rotation_angle, 
 MAX_JOINT_STEP = 0.12
 #: A straight segment's pose that IK misses by more than this (m) is out of reach.
 OUT_OF_REACH = 0.02
+#: How far (m) from a free-space goal out of comfortable reach the first IK answer may
+#: leave the hand before :meth:`ArmDriver.solve_anywhere` looks for a closer one.
+FAR_MISS = 0.1
 #: How far inside its joint limits (rad or m) a free-space move's goal configuration stays.
 LIMIT_MARGIN = 0.15
 #: How far inside its joint limits (rad or m) a line that must be followed stays, and the
@@ -146,9 +150,10 @@ class ArmDriver:
         result = self.kin.inverse(tuple(pose.p), pose.quat, seed=self.q, restarts=0,
                                   max_iterations=300)
         if not self._comfortable(result):
-            best = None
+            best, tried = None, [result]
             for seed in (self.q, self.kin.spec.home, *self._seeds()):
                 r = self.kin.inverse(tuple(pose.p), pose.quat, seed=seed, restarts=0)
+                tried.append(r)
                 if self._comfortable(r) and (
                         best is None or _jump(r, self.q) < _jump(best, self.q)):
                     best = r
@@ -156,14 +161,29 @@ class ArmDriver:
             # top-down grasp close to the base has comfortable answers far from home)
             for seed in (self._wide_seeds() if best is None else ()):
                 r = self.kin.inverse(tuple(pose.p), pose.quat, seed=seed, restarts=0)
+                tried.append(r)
                 if self._comfortable(r) and (
                         best is None or _jump(r, self.q) < _jump(best, self.q)):
                     best = r
-            if best is None:
-                self.ik_misses += 1
-            else:
-                result = best
-        return np.clip(result.qpos, self.kin.limits[:, 0], self.kin.limits[:, 1])
+            if best is None:  # out of comfortable reach: the first answer, clipped to the
+                self.ik_misses += 1  # limits, unless that leaves the hand far off (by a
+                first = self._clip(result.qpos)  # metre: joints far outside them); then the
+                if self._miss(first, pose) <= FAR_MISS:  # answer that comes closest
+                    return first
+                return min((self._clip(r.qpos) for r in tried), key=lambda q: self._miss(q, pose))
+            result = best
+        return self._clip(result.qpos)
+
+    def _clip(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.clip(np.asarray(q, dtype=np.float64), self.kin.limits[:, 0], self.kin.limits[:, 1])
+
+    def _miss(self, q: NDArray[np.float64], pose: Pose) -> float:
+        """How far the TCP at joints ``q`` is from ``pose`` (m; 1 cm per 0.1 rad of turn),
+        with a centimetre per radian that the joints move from the last command."""
+        tcp = self.kin.tcp_pose(q)
+        return (float(np.linalg.norm(np.asarray(tcp.p) - pose.p))
+                + 0.1 * rotation_angle(quat_to_matrix(tcp.q), pose.R)
+                + 0.01 * float(np.max(np.abs(q - self.q))))
 
     def tracks(self, q: NDArray[np.float64], start: Pose, end: Pose) -> bool:
         """Whether the straight line from ``start`` (at joints ``q``) to ``end`` is solved
@@ -362,14 +382,13 @@ def expand(segment: Segment, drivers: Mapping[str, ArmDriver], dt: float,
         q1 = {name: np.asarray(segment.joints[name], dtype=np.float64) if name in segment.joints
               else drivers[name].solve_anywhere(t, segment.branch_of.get(name))
               for name, t in segment.targets.items()}
-        joint_speed = angular_speed
-        n = max(n, max(int(np.ceil(float(np.max(np.abs(q1[k] - q0[k]))) / (joint_speed * dt)))
-                       for k in q0))
+        paths = {name: _joint_path(drivers[name].kin, q0[name], q1[name]) for name in q0}
+        n = max(n, max(int(np.ceil(path.length / (angular_speed * dt))) for path in paths.values()))
         for i in range(1, n + 1):
             s = _ease(i / n)
             for name in segment.targets:
                 d = drivers[name]
-                d.q = q0[name] + s * (q1[name] - q0[name])
+                d.q = paths[name].at(s)
                 tcp = d.kin.tcp_pose(d.q)
                 d.pose = Pose.of(tcp.p, quat_to_matrix(tcp.q))
             steps.append(_snapshot(drivers, segment.label))
@@ -426,6 +445,60 @@ def _straight_line_ok(segment: Segment, drivers: Mapping[str, ArmDriver], dt: fl
                 if alternative is not None and alternative > clear + 0.005:
                     return False
     return True
+
+
+#: How far (m) a joint-space move may take the TCP below the lower of its two ends, and
+#: how high above the table (z = 0) it must stay, before it goes by way of the arm's home:
+#: an arm changing IK branch may swing its hand down into the table on the straight line
+#: between the two joint vectors.
+DIP = 0.02
+FLOOR = 0.03
+#: Joint configurations checked along each straight piece of a joint-space move.
+DIP_SAMPLES = 24
+
+
+@dataclass(frozen=True)
+class JointPath:
+    """A joint-space move: straight lines between joint waypoints, walked by the largest
+    joint's travel (rad or m)."""
+
+    waypoints: tuple[NDArray[np.float64], ...]
+
+    @property
+    def length(self) -> float:
+        return float(sum(np.max(np.abs(b - a)) for a, b in pairwise(self.waypoints)))
+
+    def at(self, s: float) -> NDArray[np.float64]:
+        """The joints a fraction ``s`` (0-1) of the way along."""
+        total = self.length
+        if total <= 0.0:
+            return self.waypoints[-1].copy()
+        left = s * total
+        for a, b in pairwise(self.waypoints):
+            piece = float(np.max(np.abs(b - a)))
+            if left <= piece or b is self.waypoints[-1]:
+                return a + min(1.0, left / piece if piece > 0 else 1.0) * (b - a)
+            left -= piece
+        return self.waypoints[-1].copy()
+
+
+def _lowest_tcp(kin, a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    """The TCP's lowest height (m) on the joint-space line from ``a`` to ``b``."""
+    return min(float(kin.tcp_pose(a + s * (b - a)).p[2])
+               for s in np.linspace(0.0, 1.0, DIP_SAMPLES))
+
+
+def _joint_path(kin, q0: NDArray[np.float64], q1: NDArray[np.float64]) -> JointPath:
+    """The straight joint-space move from ``q0`` to ``q1``, or, where it takes the TCP more
+    than DIP below both ends and lower than FLOOR, the move by way of the arm's home
+    configuration when that keeps the TCP higher."""
+    floor = min(float(kin.tcp_pose(q0).p[2]), float(kin.tcp_pose(q1).p[2])) - DIP
+    direct = _lowest_tcp(kin, q0, q1)
+    if direct >= min(floor, FLOOR):
+        return JointPath((q0, q1))
+    home = np.clip(np.asarray(kin.spec.home, dtype=np.float64), kin.limits[:, 0], kin.limits[:, 1])
+    via = min(_lowest_tcp(kin, q0, home), _lowest_tcp(kin, home, q1))
+    return JointPath((q0, home, q1)) if via > direct + DIP else JointPath((q0, q1))
 
 
 def _ease(s: float) -> float:

@@ -30,3 +30,54 @@ def test_a_pose_out_of_reach_holds_the_arm_where_it_is(rise: float) -> None:
     assert driver.ik_misses == 1
     assert float(np.max(np.abs(q - q0))) <= MAX_JOINT_STEP
     env.close()
+
+
+#: Baxter's right arm carrying a block toward a pot 1 m from its base (the sampler's draw
+#: 27), with its hand top-down: beyond its reach.
+BEYOND_BAXTER = (0.149, 0.219, 0.114)
+#: Two configurations of Baxter's right arm, the hand 27 and 15 cm above the table: the
+#: straight joint-space line between them takes it 7 cm into the table.
+HIGH = (0.08, 0.3, -1.62, 1.34, 0.78, 1.51, -1.44)
+LOWER = (-0.26, -0.64, 0.89, 2.02, -0.46, 0.31, -2.64)
+
+
+@pytest.fixture
+def baxter():
+    from fsvla.env import make
+    from fsvla.experts.world import World
+    from fsvla.resources import scenarios_dir
+
+    env = make(str(scenarios_dir() / "boundary" / "move_block_past_glass_baxter.fsv"), "L0", 0)
+    env.reset()
+    yield World.of_env(env)
+    env.close()
+
+
+def test_a_free_space_goal_out_of_reach_ends_where_the_hand_comes_closest(baxter) -> None:
+    """No comfortable answer: the driver took the first solver run's joints, clipped to the
+    limits, which put the hand 0.98 m above the table; now the joints (within the limits)
+    that bring the hand closest."""
+    from fsvla.experts.motion import ArmDriver, Pose
+
+    now = baxter.current_pose("right")
+    driver = ArmDriver("right", baxter.kinematics("right"), now, baxter.arm_joints("right"), 1.0)
+    goal = Pose(np.array(BEYOND_BAXTER), now.R)
+    q = driver.solve_anywhere(goal)
+    assert driver.ik_misses == 1
+    reached = np.asarray(baxter.kinematics("right").tcp_pose(q).p)
+    assert np.linalg.norm(reached - goal.p) < 0.15, reached
+
+
+def test_a_joint_space_move_that_would_dip_into_the_table_goes_by_way_of_home(baxter) -> None:
+    from fsvla.experts.motion import FLOOR, ArmDriver, Pose, Segment, expand
+
+    kin = baxter.kinematics("right")
+    q0, q1 = np.array(HIGH), np.array(LOWER)
+    start, end = kin.tcp_pose(q0), kin.tcp_pose(q1)
+    direct = min(kin.tcp_pose(q0 + s * (q1 - q0)).p[2] for s in np.linspace(0.0, 1.0, 50))
+    assert direct < 0.0  # the premise
+    driver = ArmDriver("right", kin, Pose.of(start.p, baxter.current_pose("right").R), q0, 1.0)
+    steps = expand(Segment({"right": Pose.of(end.p, driver.pose.R)}, joint_space=True,
+                           joints={"right": q1}), {"right": driver}, 0.05, 1.0)
+    assert min(step.pose["right"].p[2] for step in steps) > FLOOR
+    assert np.allclose(steps[-1].q["right"], q1)
