@@ -16,13 +16,11 @@ Vertices of the convex collision hulls are a slight over-estimate of the true di
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import NDArray
 
 from fsvla.compiler.monitor import RobotEntity, ZoneEntity
-from fsvla.compiler.pose import quat_to_matrix, rotation_angle
+from fsvla.compiler.pose import quat_to_matrix
 
 from .world import World
 
@@ -44,7 +42,7 @@ class ArmClearance:
         zones = {z.name: z for z in world.scene.zones}
         # links held by the hand (the hand itself, its fingers, the flange): where the TCP
         # goes they go, whatever the joints; the TCP's path keeps them clear, not the IK
-        rigid = self._hand_rigid(names)
+        rigid = world.hand_rigid_links(arm)
         self._checks: list[tuple[list[int], str, float]] = []  # (link indices, reference, limit)
         for channel in world.monitor.channels:
             if channel.metric not in METRICS or channel.reference is None:
@@ -65,25 +63,6 @@ class ArmClearance:
             vertices = self.kin.link_vertices(i)
             if vertices is not None:
                 self._vertices[i] = vertices
-
-    def _hand_rigid(self, names: list[str]) -> set[int]:
-        """Indices of the links whose pose relative to the TCP no joint of the arm moves."""
-        kin = self.kin
-        home = np.asarray(kin.spec.home, dtype=np.float64)
-        rng = np.random.default_rng(0)
-        ee, every = names.index(kin.spec.ee_link), range(len(names))
-        relative = []
-        for q in (home, home + rng.uniform(-0.3, 0.3, home.shape)):
-            p, quat = kin.link_poses(q, every)
-            R = quat_to_matrix(quat)
-            p = np.asarray(p, dtype=np.float64)
-            relative.append([(R[ee].T @ (p[i] - p[ee]), R[ee].T @ R[i]) for i in every])
-        rigid = set()
-        for i, ((pa, Ra), (pb, Rb)) in enumerate(zip(*relative)):
-            if (np.allclose(pa, pb, atol=1e-5)  # float32 poses
-                    and 1.0 - math.cos(rotation_angle(Ra, Rb) / 2.0) < 1e-5):
-                rigid.add(i)
-        return rigid
 
     @property
     def active(self) -> bool:

@@ -14,7 +14,7 @@ from fsvla.compiler.pose import quat_to_matrix
 from .motion import Pose
 from .skills import Grasp, horizontal, top_down_grasp
 from .style import Style
-from .world import World, box_distance
+from .world import HAND_DEPTH, World, box_distance
 
 
 def grasps(world: World, arm: str, obj: str) -> list[Grasp]:
@@ -89,7 +89,8 @@ def _cylinder(world: World, arm: str, obj: str) -> list[Grasp]:
     across = np.cross(UPV, towards)
     grip = _grip_height(world, arm, obj, h)
     if grip is None and 2 * r < 0.92 * world.max_width(arm):
-        grip = max(0.3 * h, h - HAND_DEPTH), 2 * r  # a piece that is not a cylinder (a cup)
+        # a piece that is not a cylinder (a cup)
+        grip = max(0.3 * h, h - world.hand_depth(arm)), 2 * r
     if grip is not None:
         height, width = grip
         centre = world.to_world(obj, (0.0, 0.0, height))
@@ -104,13 +105,15 @@ PAD_HALF = 0.01
 
 def _grip_height(world: World, arm: str, obj: str, h: float) -> tuple[float, float] | None:
     """Where a top-down hand grips an upright object made of cylinder pieces: the TCP's
-    height above the object's base, as low as the palm still clears the object's top, with
-    the pads on one upright cylinder piece narrower than the gripper (the highest such
-    piece), and that piece's width; None when no piece fits."""
-    low = h - HAND_DEPTH  # the palm clears the top
+    height above the object's base, as low as the palm still clears the object's top
+    (:meth:`World.hand_depth`), with the pads on one upright cylinder piece narrower than
+    the gripper opens and wider than its shut fingers leave (the highest such piece), and
+    that piece's width; None when no piece fits."""
+    low = h - world.hand_depth(arm)  # the palm clears the top
     found: list[tuple[float, float, float]] = []
     for shape in world.asset(obj).collision:
         if shape.type != "cylinder" or 2 * shape.radius >= 0.92 * world.max_width(arm) \
+                or 2 * shape.radius < world.min_width(arm) \
                 or quat_to_matrix(shape.pose.quaternion)[2, 2] < 0.99:
             continue
         z, half = float(shape.pose.position[2]), float(shape.half_length)
@@ -125,9 +128,6 @@ def _grip_height(world: World, arm: str, obj: str, h: float) -> tuple[float, flo
 UPV = np.array([0.0, 0.0, 1.0])
 #: Half the length of a Panda hand along its finger axis (m), with its collision hull.
 HAND_HALF_LENGTH = 0.105
-#: The hand's body reaches down to 37 mm above the TCP: a top-down TCP stays this far
-#: (m) below an object's top, so that the palm clears it by 9 mm.
-HAND_DEPTH = 0.028
 
 
 def _mug(world: World, arm: str, obj: str) -> list[Grasp]:
@@ -171,7 +171,7 @@ def _block(world: World, arm: str, obj: str) -> list[Grasp]:
     out = []
     for axis in (0, 1):
         closing = pose.R[:, axis]
-        if 2 * half[axis] < 0.92 * world.max_width(arm):
+        if world.min_width(arm) <= 2 * half[axis] < 0.92 * world.max_width(arm):
             g = top_down_grasp(world, arm, centre + np.array([0.0, 0.0, 0.3 * half[2]]), closing,
                                2 * half[axis])
             out.append((abs(float(closing @ towards)), g))

@@ -53,6 +53,12 @@ EASE_STEPS = 12
 #: of its range a control step (a soft finger drive swinging shut faster meets the object
 #: with a squeeze of 50-60 N in one step, before the guard can feel it).
 SLOW_CLOSE = 0.005
+#: How much wider (m) than the object careful fingers close quickly before SLOW_CLOSE:
+#: sliding fingers, whose opening is their travel; a jaw on a hinge, whose gap where it
+#: meets the object is not the one at its tips that the width model gives (a Z1's jaw met
+#: a bottle before its tips were 6 mm from it, and squeezed it at 150 N in one step).
+PRECLOSE_GAP = 0.006
+PRECLOSE_GAP_HINGED = 0.015
 #: How close (m) the tips of a jaw on a hinge may come to what a grasped object stands on.
 TIP_GAP = 0.004
 #: How far (m) beyond a pose, away from the arm's base, the arm must still reach for the
@@ -402,11 +408,12 @@ def jaws_clear_of_support(world: World, arm: str, obj: str, grasp: Grasp) -> Gra
     """A grasp from above raised, where it must be, so that the jaws as they are now
     (opened for it) stay :data:`TIP_GAP` above the bottom of ``obj``, what it stands on: a
     fixed jaw reaches past the TCP (the Z1's by 2 cm), and a grasp low on a small block
-    would drive it into the table."""
-    if grasp.approach[2] > -0.7:
+    would drive it into the table; a hand leaning forward brings the corner of a wide jaw
+    lower still."""
+    if grasp.approach[2] > -0.3:
         return grasp
-    floor = float(world.bounds(obj)[0][2]) + world.hand_reach(arm) * -float(grasp.approach[2]) \
-        + TIP_GAP
+    below = world.hand_front(arm, grasp.pose.R, -UP, grasp.pose.p, np.inf)
+    floor = float(world.bounds(obj)[0][2]) + below + TIP_GAP
     if grasp.pose.p[2] >= floor:
         return grasp
     p = grasp.pose.p.copy()
@@ -496,7 +503,8 @@ def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj:
     if force_watched(world, obj) or not all(world.fingers_slide(arm) for arm in widths):
         # slowly over the last millimetres: a jaw on a hinge swinging shut at speed knocks
         # the object across the table before it squeezes it
-        near = {arm: world.opening_fraction(arm, widths[arm] + 0.006) for arm in widths}
+        near = {arm: world.opening_fraction(arm, widths[arm] + preclose_gap(world, arm))
+                for arm in widths}
         yield Segment(grippers=near, gripper_steps=style.gripper_steps, label="preclose")
         steps = max([2 * style.gripper_steps] + [
             int(np.ceil((near[arm] - target[arm]) / SLOW_CLOSE)) for arm in widths])
@@ -539,6 +547,11 @@ def squeeze_until_felt(world: World, style: Style, force: Mapping[str, float], o
         yield Segment(grippers={arm: goal[arm] for arm in loose},
                       gripper_steps=style.gripper_steps, settle=2,
                       guards=tuple(guard[arm] for arm in loose), label="squeeze")
+
+
+def preclose_gap(world: World, arm: str) -> float:
+    """How much wider (m) than the object ``arm``'s fingers close quickly, before SLOW_CLOSE."""
+    return PRECLOSE_GAP if world.fingers_slide(arm) else PRECLOSE_GAP_HINGED
 
 
 def grip_guard(world: World, arm: str, force: float, obj: str) -> Guard:

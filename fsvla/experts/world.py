@@ -9,6 +9,7 @@ state. ``World.of_env(env)`` makes one from an :class:`fsvla.env.FsvlaEnv`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,6 +24,16 @@ from fsvla.embodiments.spec import ArmSpec
 from fsvla.world import ArmModel, SceneState
 
 from .motion import Pose
+
+#: How far (m) the hand's body clears an object's top in a top-down grip.
+PALM_CLEARANCE = 0.009
+#: How far (m) below an object's top a hand whose body is not measured grips it: a
+#: Panda's body reaches down to 37 mm above its TCP.
+HAND_DEPTH = 0.028
+#: How far (m) behind the TCP, along the approach, a finger's hull counts as its pad.
+PAD_DEPTH = 0.035
+#: How much wider (m) than the gap its shut fingers leave an object must be to be squeezed.
+SQUEEZE_SPARE = 0.004
 
 
 def box_distance(p: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]) -> float:
@@ -56,6 +67,8 @@ class World:
         self._kinematics: dict[str, ArmModel] = {}
         self._finger_axis: dict[str, NDArray[np.float64]] = {}
         self._open_width: dict[str, float] = {}
+        self._closed_gap: dict[str, float] = {}
+        self._rigid: dict[str, frozenset[int]] = {}
 
     @classmethod
     def of_env(cls, env: Any) -> World:
@@ -145,6 +158,54 @@ class World:
             self._kinematics[arm] = self.state.arm_model(arm)
         return self._kinematics[arm]
 
+    def hand_rigid_links(self, arm: str) -> frozenset[int]:
+        """Indices (in the arm model's links) of the links whose pose relative to the TCP no
+        joint of the arm moves: the hand, its fingers as the model holds them, the flange."""
+        if arm not in self._rigid:
+            kin = self.kinematics(arm)
+            names = list(kin.link_names)
+            home = np.asarray(kin.spec.home, dtype=np.float64)
+            rng = np.random.default_rng(0)
+            ee, every = names.index(kin.spec.ee_link), range(len(names))
+            relative = []
+            for q in (home, home + rng.uniform(-0.3, 0.3, home.shape)):
+                p, quat = kin.link_poses(q, every)
+                R = quat_to_matrix(quat)
+                p = np.asarray(p, dtype=np.float64)
+                relative.append([(R[ee].T @ (p[i] - p[ee]), R[ee].T @ R[i]) for i in every])
+            self._rigid[arm] = frozenset(
+                i for i, ((pa, Ra), (pb, Rb)) in enumerate(zip(*relative))
+                if np.allclose(pa, pb, atol=1e-5)  # float32 poses
+                and 1.0 - np.cos(rotation_angle(Ra, Rb) / 2.0) < 1e-5)
+        return self._rigid[arm]
+
+    def hand_depth(self, arm: str) -> float:
+        """How far (m) below an object's top a top-down TCP may grip it, the hand's body (a
+        Panda's, 37 mm above its TCP; Baxter's gripper base, 10 cm) clearing the top by
+        PALM_CLEARANCE: measured on the hulls of the hand's links other than its fingers.
+        A jaw on a hinge grips with its tips: HAND_DEPTH below the top, its gap narrowing
+        toward the hinge."""
+        if not self.fingers_slide(arm):
+            return HAND_DEPTH
+        kin = self.kinematics(arm)
+        names = list(kin.link_names)
+        fingers = set(self.arm_spec(arm).gripper.finger_links)
+        q = np.asarray(kin.spec.home, dtype=np.float64)
+        tcp = kin.tcp_pose(q)
+        back = -(quat_to_matrix(tcp.q) @ self.approach_axis(arm))
+        positions, quaternions = kin.link_poses(q, list(range(len(names))))
+        depth = None
+        for i in self.hand_rigid_links(arm):
+            vertices = kin.link_vertices(i)
+            if names[i] in fingers or vertices is None:
+                continue
+            points = vertices @ quat_to_matrix(quaternions[i]).T + np.asarray(positions[i])
+            lowest = float(np.min((points - np.asarray(tcp.p)) @ back))
+            depth = lowest if depth is None else min(depth, lowest)
+        if depth is None or depth <= PALM_CLEARANCE:
+            return HAND_DEPTH
+        return math.floor((depth - PALM_CLEARANCE) * 1000.0) / 1000.0  # to the millimetre
+
     def base_position(self, arm: str) -> NDArray[np.float64]:
         base = self.state.robot_link_pose(arm, self.arm_spec(arm).base_link)
         return np.asarray(base.p, dtype=np.float64)
@@ -201,6 +262,36 @@ class World:
         tcp = self.current_pose(arm)
         return tcp.R.T @ (0.5 * (a + b) - tcp.p)
 
+    def closed_gap(self, arm: str) -> float:
+        """How far apart (m) sliding fingers' pads stay when the gripper is shut: their
+        collision hulls within PAD_DEPTH behind the TCP, measured across the closing axis,
+        less the width model's gap for the opening they are at (Baxter's fingertips stop
+        1.6 cm apart; a Panda's meet). Zero for a jaw on a hinge, whose model is its tips."""
+        if arm not in self._closed_gap:
+            self._closed_gap[arm] = self._measure_closed_gap(arm)
+        return self._closed_gap[arm]
+
+    def _measure_closed_gap(self, arm: str) -> float:
+        fingers = self.arm_spec(arm).gripper.finger_links
+        if len(fingers) < 2 or not self.fingers_slide(arm):
+            return 0.0
+        tcp = self.current_pose(arm)
+        across, back = tcp.R @ self.finger_axis(arm), -(tcp.R @ self.approach_axis(arm))
+        sides: dict[bool, list[float]] = {True: [], False: []}
+        for link in fingers:
+            points = self.link_points(arm, link)
+            if points is None:
+                continue
+            rel = points - tcp.p
+            pads = rel[rel @ back < PAD_DEPTH] @ across
+            if len(pads):
+                positive = float(np.mean(pads)) > 0.0
+                sides[positive].append(float(np.min(pads) if positive else np.max(pads)))
+        if not sides[True] or not sides[False]:
+            return 0.0
+        gap = min(sides[True]) - max(sides[False])
+        return max(0.0, gap - self.gripper_opening(arm) * self.travel(arm))
+
     def fingers_slide(self, arm: str) -> bool:
         """Whether the fingers' opening is their joints' travel (parallel sliding fingers
         that meet when closed, as a Panda hand's), not a jaw on a hinge or fingers that
@@ -208,8 +299,16 @@ class World:
         return abs(self.open_width(arm) - self.travel(arm)) <= 0.01
 
     def max_width(self, arm: str) -> float:
-        """The gripper's opening (m between the fingers) when fully open."""
+        """The gripper's opening (m between the fingers) when fully open: for sliding fingers
+        their travel, what the width checks count on (fingers that stay apart when shut,
+        Baxter's, open wider by their :meth:`closed_gap`)."""
         return self.travel(arm) if self.fingers_slide(arm) else self.open_width(arm)
+
+    def min_width(self, arm: str) -> float:
+        """The narrowest object (m) the gripper squeezes: a little wider than the gap its
+        shut fingers leave."""
+        gap = self.closed_gap(arm)
+        return gap + SQUEEZE_SPARE if gap > 0.0 else 0.0
 
     def opening_fraction(self, arm: str, width: float) -> float:
         """The gripper opening (0 shut, 1 open) at which the fingers are ``width`` (m)
@@ -220,7 +319,9 @@ class World:
             return 1.0
         if width <= 0.0:
             return 0.0
-        if self.fingers_slide(arm) or len(self.arm_spec(arm).gripper.finger_links) < 2:
+        if self.fingers_slide(arm):
+            return float(np.clip((width - self.closed_gap(arm)) / self.travel(arm), 0.0, 1.0))
+        if len(self.arm_spec(arm).gripper.finger_links) < 2:
             return float(width / self.max_width(arm))
         kin = self.kinematics(arm)
         lo, hi = 0.0, 1.0

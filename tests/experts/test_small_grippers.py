@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from fsvla.experts import rollout
-from fsvla.experts.world import World
+from fsvla.experts.style import CAREFUL
+from fsvla.experts.world import HAND_DEPTH, World
+from fsvla.resources import scenarios_dir
 
 pytestmark = pytest.mark.sim
 
@@ -147,3 +149,161 @@ def test_the_z1s_fixed_jaw_stays_off_the_table_beside_a_low_block(tmp_path: Path
     env.close()
     assert {"approach", "reach", "preclose"} <= labels
     assert pressed < 0.5, f"the hand pressed with {pressed:.1f} N on its way down"
+
+
+
+def test_a_leaning_hand_is_raised_until_its_lowest_jaw_corner_clears_the_table(
+        tmp_path: Path) -> None:
+    """A grasp tilted 50 deg from the vertical was left where it was (only grasps within
+    45 deg of it were raised, by the jaws' reach along the approach): the Z1's jaws, 8 cm
+    wide, leaning over, reached below the table beside a low block."""
+    from fsvla.env import make
+    from fsvla.experts import grasps
+    from fsvla.experts.skills import TIP_GAP, UP, jaws_clear_of_support
+
+    path = tmp_path / "low_block.fsv"
+    path.write_text(LOW_BLOCK_Z1, encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    arm = world.arm_names[0]
+    bottom = float(world.bounds("block")[0][2])
+    for angle in (0.0, 35.0, 50.0):
+        grasp = grasps.tilted(world, arm, grasps.grasps(world, arm, "block")[0],
+                              float(np.deg2rad(angle)))
+        raised = jaws_clear_of_support(world, arm, "block", grasp)
+        lowest = raised.pose.p[2] - world.hand_front(arm, raised.pose.R, -UP, raised.pose.p,
+                                                     np.inf)
+        assert lowest >= bottom + TIP_GAP - 1e-6, (angle, lowest)
+    env.close()
+
+
+#: The sampler's draw 12 (``fsvla.validate.sampler``, seed 12): Baxter lifts a bottle whose
+#: neck (1.6 cm) is as wide as the gap its left hand's shut fingertips leave.
+THIN_NECK_BAXTER = """\
+scenario sampled_0012_lift_baxter
+  suite force
+  task lift(object=bottle)
+  embodiment baxter
+  instruction "Lift the bottle."
+  horizon 30 s
+
+  object bottle: bottle(radius=1.5 cm, height=18.3 cm, mass=104 g, color=blue) at (-13.3 cm, 5.7 cm)
+
+  constrain grip: contact_force(gripper) <= 41 N warn 10 N cost quadratic
+  watch tilt(bottle) <= 60 deg warn 20 deg
+  constrain separation(left_arm, right_arm) >= 0 cm warn 3 cm
+
+  success lifted(bottle, by=8 cm) for 1 s
+
+  variants
+    L1: jitter bottle 2 cm
+    L2: tighten grip to 33 N, clutter 1 near bottle
+"""
+
+
+def test_shut_fingers_that_stay_apart_are_measured_on_their_hulls(tmp_path: Path,
+                                                                   scenario: Path) -> None:
+    """Baxter's fingertips stop 1.6 cm apart on its left hand and 6.5 mm on its right (a
+    different pair of tips); the width model, which puts the fingers' points together when
+    shut, took the 1.6 cm neck of a bottle for something to squeeze, and the fingers closed
+    on it without a touch. An SO-101's jaw is a hinge: no gap is measured."""
+    from fsvla.env import make
+    from fsvla.experts import grasps
+
+    path = tmp_path / "neck.fsv"
+    path.write_text(THIN_NECK_BAXTER, encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    assert world.fingers_slide("left")
+    assert world.closed_gap("left") == pytest.approx(0.016, abs=0.002)
+    assert world.closed_gap("right") == pytest.approx(0.0065, abs=0.002)
+    travel = world.travel("left")
+    assert world.opening_fraction("left", 0.03) == pytest.approx(
+        (0.03 - world.closed_gap("left")) / travel)
+    assert world.opening_fraction("left", 0.01) == 0.0
+    # Baxter's fingers are 11 cm long: the body is gripped 9.4 cm below the top (the
+    # gripper base clears it by 9 mm), not 2.8 cm, where the neck is
+    assert world.hand_depth("left") == pytest.approx(0.094)
+    grasp = grasps.choose(world, CAREFUL, "left", "bottle")
+    assert grasp.width == pytest.approx(0.03)  # the body, not the neck
+    assert grasp.pose.p[2] == pytest.approx(0.183 - 0.094, abs=1e-3)
+    env.close()
+    env = make(str(scenario), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    assert world.closed_gap("arm") == 0.0
+    assert world.hand_depth("arm") == HAND_DEPTH  # a jaw on a hinge grips with its tips
+    env.close()
+    env = make(str(scenarios_dir() / "force" / "lift_glass_gently.fsv"), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    arm = world.arm_names[0]
+    assert world.closed_gap(arm) < 1e-3  # a Panda's fingers meet
+    assert world.hand_depth(arm) == pytest.approx(0.028)  # its hand's body 37 mm up
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", ["L0", "L1", "L2"])
+def test_baxter_lifts_a_bottle_by_its_body_where_its_neck_is_too_thin(tmp_path: Path,
+                                                                     level: str) -> None:
+    from fsvla.run.plan import layout_seed
+
+    path = tmp_path / "neck.fsv"
+    path.write_text(THIN_NECK_BAXTER, encoding="utf-8")
+    result = rollout(str(path), "careful", level, layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 44: a Z1 takes a 5.8 cm bottle 3 cm below its top.
+BOTTLE_Z1 = """\
+scenario sampled_0044_pick_place_z1
+  suite force
+  task pick_place(object=bottle, target=plate)
+  embodiment z1
+  instruction "Put the bottle on the plate."
+  horizon 30 s
+
+  object bottle: bottle(radius=2.9 cm, height=19.3 cm, mass=110 g, color=orange) at (-1 cm, 13.7 cm)
+  object plate: plate(radius=8.1 cm) at (25.3 cm, -11.4 cm)
+
+  constrain grip: contact_force(gripper) <= 47 N warn 12 N cost quadratic
+  constrain landing: contact_force(bottle) <= 19 N warn 6 N
+  watch tilt(bottle) <= 60 deg warn 20 deg
+
+  success on(bottle, plate) and released(bottle) for 0.5 s
+
+  variants
+    L1: jitter bottle 2 cm, jitter plate 2 cm
+    L2: tighten grip to 38 N, clutter 2 near plate
+"""
+
+
+def test_a_hinged_jaw_closes_slowly_from_well_short_of_the_object(tmp_path: Path) -> None:
+    """The Z1's jaw closed quickly to 6 mm short of the bottle by its width model and met
+    it there, its soft drive lagging the command: 149 N in one step. From 1.5 cm short,
+    slowly, it meets the bottle with about 50 N."""
+    from fsvla.env import make
+    from fsvla.experts.policy import make_expert
+
+    path = tmp_path / "bottle.fsv"
+    path.write_text(BOTTLE_Z1, encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    expert = make_expert(env, "careful")
+    obs, _ = env.reset()
+    expert.reset(None)
+    world = World.of_env(env)
+    step, labels, felt = 0, [], 0.0
+    while "lift" not in labels and step < 400:
+        for action in expert.act(obs):
+            label = expert.labels[step] if step < len(expert.labels) else ""
+            obs, *_ = env.step(action)
+            step += 1
+            labels.append(label)
+            if label in ("preclose", "close"):
+                felt = max(felt, world.hand_force("arm", "bottle"))
+    env.close()
+    assert "close" in labels
+    assert 0.0 < felt < 80.0, f"the jaw met the bottle with {felt:.0f} N"

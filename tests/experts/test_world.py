@@ -62,9 +62,11 @@ class FakeState:
 
 @dataclass
 class FakeModel:
-    """A parallel gripper 8 cm wide at (0.3, 0, 0.4), closing along world y."""
+    """A parallel gripper 8 cm wide at (0.3, 0, 0.4), closing along world y; no link has
+    a collision hull."""
 
     arm: str
+    link_names: tuple[str, ...] = ()
 
     def finger_points(self, fraction: float) -> np.ndarray:
         return np.array([(0.3, 0.04 * fraction, 0.4), (0.3, -0.04 * fraction, 0.4)])
@@ -124,6 +126,7 @@ def test_the_arm(drawer) -> None:
     assert world.open_width("arm") == pytest.approx(0.08)
     assert world.fingers_slide("arm")  # the Panda hand's 2 × 4 cm travel is its opening
     assert world.grip_centre("arm", 0.05) == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
+    assert world.closed_gap("arm") == 0.0  # no hulls to measure the shut fingers on
     assert world.kinematics("arm") is world.kinematics("arm")
     assert world.kinematics("arm").arm == "arm"
     assert state.reads.count("model arm") == 1  # made once, kept
