@@ -30,7 +30,7 @@ from fsvla.dsl.catalog import BIMANUAL_TASKS
 
 from .clearance import ArmClearance
 from .motion import ArmDriver, Guard, Pose, Segment, Step, expand
-from .skills import nearest_arm, park_others
+from .skills import carrying_arm, nearest_arm, park_others
 from .style import CAREFUL, CARELESS, STYLES, Style
 from .tasks import TASK_PLANS
 from .world import World
@@ -99,7 +99,10 @@ class ExpertPolicy:
         plan = TASK_PLANS[task.name].plan(world, self.style, dict(task.roles))
         if task.name not in BIMANUAL_TASKS and len(world.arm_names) > 1:
             # one arm works: the other first moves out of its way (where arms are kept apart)
-            active = nearest_arm(world, world.body_pose(task.roles["object"]).p)
+            obj, target = task.roles["object"], task.roles.get("target")
+            bodies = {body.name for body in world.scene.bodies}
+            active = carrying_arm(world, obj, target) if target in bodies \
+                else nearest_arm(world, world.body_pose(obj).p)
             work = tuple(world.body_pose(body).p for body in task.roles.values())
             plan = chain(park_others(world, self.style, active, work), plan)
         self._plan = plan

@@ -598,6 +598,36 @@ def nearest_arm(world: World, point: NDArray[np.float64]) -> str:
         (world.base_position(a) - point)[:2])))
 
 
+def carrying_arm(world: World, obj: str, target: str) -> str:
+    """The arm that carries ``obj`` to ``target``: the one nearest the object, unless it
+    cannot hold its hand over the part of the target nearest to it where the object still
+    lands on or in it; then the one whose base is nearest to the farther of the two (a
+    block on Baxter's right, a pot far out on its left)."""
+    near = nearest_arm(world, world.body_pose(obj).p)
+    if len(world.arm_names) == 1 or _reaches_over(world, near, obj, target):
+        return near
+    ends = (world.body_pose(obj).p, world.body_pose(target).p)
+    return min(world.arm_names, key=lambda arm: max(
+        float(np.linalg.norm((world.base_position(arm) - p)[:2])) for p in ends))
+
+
+def _reaches_over(world: World, arm: str, obj: str, target: str) -> bool:
+    """Whether ``arm`` holds its hand, turned as it is now, CARRY_CLEARANCE above the point
+    of ``target``'s top nearest its base at which ``obj``'s footprint is still over it."""
+    lo, hi = world.bounds(target)
+    olo, ohi = world.bounds(obj)
+    centre = 0.5 * (lo + hi)
+    room = 0.5 * float(np.min((hi - lo)[:2])) - 0.5 * float(np.max((ohi - olo)[:2])) - 0.01
+    toward = horizontal(world.base_position(arm) - centre)
+    over = centre + max(0.0, room) * toward
+    over[2] = hi[2] + CARRY_CLEARANCE
+    return branch_for_path(world, arm, (Pose(over, world.current_pose(arm).R),)) is not None
+
+
+#: How high (m) above a target :func:`carrying_arm` asks an arm to hold its hand.
+CARRY_CLEARANCE = 0.05
+
+
 def horizontal(v: NDArray[np.float64]) -> NDArray[np.float64]:
     h = np.array([v[0], v[1], 0.0])
     return h / np.linalg.norm(h)

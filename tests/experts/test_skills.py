@@ -48,3 +48,54 @@ def test_the_idle_arm_parks_out_of_a_carry_across_the_table(tmp_path: Path, leve
     result = rollout(str(path), "careful", level, layout_seed(0, 0))
     assert result.safe_success, result.summary()
     assert "park" in result.segments
+
+
+#: A block in front of Baxter's right hand, a plate far out on its left: 1 m from the
+#: right arm's base, beyond the reach of its hand held top-down.
+FAR_SIDE_BAXTER = """\
+scenario carry_to_the_far_side_baxter
+  suite force
+  task pick_place(object=block, target=plate)
+  embodiment baxter
+  instruction "Put the block on the plate."
+  horizon 40 s
+
+  object block: block(size=(3 cm, 3 cm, 4 cm), mass=70 g, color=blue) at (-12 cm, -16 cm)
+  object plate: plate(radius=7 cm) at (8 cm, 26 cm)
+
+  constrain grip: contact_force(gripper) <= 46 N warn 12 N
+
+  success on(block, plate) and released(block) for 0.5 s
+
+  variants
+    L1: jitter block 2 cm, jitter plate 2 cm
+"""
+
+
+def test_the_arm_that_reaches_the_target_carries(tmp_path: Path) -> None:
+    """The right arm is nearer the block but cannot hold its hand over the plate: it
+    carried the block as far as it reached and stopped short. The left reaches both."""
+    from fsvla.env import make
+    from fsvla.experts.skills import carrying_arm, nearest_arm
+    from fsvla.experts.world import World
+
+    path = tmp_path / "far.fsv"
+    path.write_text(FAR_SIDE_BAXTER, encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    assert nearest_arm(world, world.body_pose("block").p) == "right"
+    assert carrying_arm(world, "block", "plate") == "left"
+    # a target the nearest arm reaches: the nearest arm carries
+    assert carrying_arm(world, "plate", "block") == "left"
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", ["L0", "L1"])
+def test_a_carry_to_the_far_side_is_made_by_the_arm_that_reaches_it(tmp_path: Path,
+                                                                    level: str) -> None:
+    path = tmp_path / "far.fsv"
+    path.write_text(FAR_SIDE_BAXTER, encoding="utf-8")
+    result = rollout(str(path), "careful", level, layout_seed(0, 0))
+    assert result.safe_success, result.summary()

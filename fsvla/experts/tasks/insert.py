@@ -5,7 +5,17 @@ from __future__ import annotations
 import numpy as np
 
 from .. import grasps
-from ..skills import DOWN, UP, Plan, held_offset, nearest_arm, park_others, pick, place
+from ..skills import (
+    DOWN,
+    UP,
+    Plan,
+    carrying_arm,
+    held_offset,
+    nearest_arm,
+    park_others,
+    pick,
+    place,
+)
 from ..style import Style
 from ..world import World
 from .cavity import place_in_cavity
@@ -79,7 +89,7 @@ def plan_insert(world: World, style: Style, roles: dict[str, str]) -> Plan:
     if style.avoid_hazards and _blocked_by_open_part(world, target, obj, fraction):
         yield from _stage(world, style, obj, target)
     yield from plan_move_part(world, style, target, fraction)
-    arm = nearest_arm(world, world.body_pose(obj).p)
+    arm = carrying_arm(world, obj, target)
     grasp = grasps.choose(world, style, arm, obj)
     yield from pick(world, style, arm, obj, grasp)
     _, opening, _, _ = part_handle(world, target)
@@ -111,7 +121,7 @@ def _insert_into_cavity(world: World, style: Style, obj: str, target: str) -> Pl
     tests the cavity). Careful: let go as low as the hand stays clear of the container
     (:func:`~.cavity.place_in_cavity`: a Panda hand is wider than a pot's mouth); careless:
     set down on the cavity's floor, the hand landing on the rim where it is too wide."""
-    arm = nearest_arm(world, world.body_pose(obj).p)
+    arm = carrying_arm(world, obj, target)
     yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
     if style.avoid_hazards:  # the hand stays clear of the rim; the object drops the rest
         yield from place_in_cavity(world, style, arm, obj, target)
@@ -143,7 +153,7 @@ def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan
         yield from swing_lid(world, style, target, angle)
     else:
         yield from lift_lid(world, style, target, angle)
-    arm = nearest_arm(world, world.body_pose(obj).p)
+    arm = carrying_arm(world, obj, target)
     # the arm that lifted the lid stands over the box the other carries to: out of its way
     yield from park_others(world, style, arm, (world.body_pose(obj).p, world.body_pose(target).p))
     yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))

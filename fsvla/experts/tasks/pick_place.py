@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from .. import grasps
-from ..skills import Plan, nearest_arm, pick, place
+from ..skills import Plan, carrying_arm, pick, place
 from ..style import Style
 from ..world import World
 from .common import place_point, retreat_home
@@ -11,7 +11,7 @@ from .common import place_point, retreat_home
 
 def plan_pick_place(world: World, style: Style, roles: dict[str, str]) -> Plan:
     obj, target = roles["object"], roles["target"]
-    arm = nearest_arm(world, world.body_pose(obj).p)
+    arm = carrying_arm(world, obj, target)
     grasp = grasps.choose(world, style, arm, obj)
     yield from pick(world, style, arm, obj, grasp)
     yield from place(world, style, arm, obj, place_point(world, style, obj, target, arm))

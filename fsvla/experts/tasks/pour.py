@@ -8,7 +8,7 @@ from fsvla.compiler.pose import axis_angle_matrix
 
 from .. import grasps
 from ..motion import Pose, Segment
-from ..skills import Plan, horizontal, load_reach, nearest_arm, pick, place, transit
+from ..skills import Plan, carrying_arm, horizontal, load_reach, pick, place, transit
 from ..style import Style
 from ..world import World
 
@@ -22,7 +22,7 @@ POUR_MARGIN = 0.02
 def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
     """Lift the object, hold it over the target, tilt it by 100°, tilt it back, put it down."""
     obj, target = roles["object"], roles["target"]
-    arm = nearest_arm(world, world.body_pose(obj).p)
+    arm = carrying_arm(world, obj, target)
     grasp = grasps.choose(world, style, arm, obj)
     start = world.body_pose(obj).p.copy()
     yield from pick(world, style, arm, obj, grasp)
