@@ -122,34 +122,50 @@ scenario lift_low_block_z1
 """
 
 
-def test_the_z1s_fixed_jaw_stays_off_the_table_beside_a_low_block(tmp_path: Path) -> None:
-    """The Z1's fixed jaw reaches 2 cm past its TCP: a grasp low on a 3 cm block put its
-    tip on the table (280 N on the hand before the jaws closed)."""
+def _felt_until(path: Path, until: str, during: tuple[str, ...],
+                other: str | None = None) -> tuple[set[str], float]:
+    """Roll the careful expert on ``path`` at L0 until it starts the segment ``until``:
+    the labels of the segments it went through, and the largest force its hand felt (from
+    ``other`` only, when given) during the segments labelled ``during``."""
     from fsvla.env import make
     from fsvla.experts.policy import make_expert
 
-    path = tmp_path / "low_block.fsv"
-    path.write_text(LOW_BLOCK_Z1, encoding="utf-8")
     env = make(str(path), "L0", 0)
     expert = make_expert(env, "careful")
     obs, _ = env.reset()
     expert.reset(None)
     world = World.of_env(env)
     arm = world.arm_names[0]
-    assert world.hand_reach(arm) > 0.015  # the premise: the jaw reaches past the TCP
-    step, labels, pressed = 0, set(), 0.0
-    while "preclose" not in labels and step < 400:
+    step, labels, felt = 0, set(), 0.0
+    while until not in labels and step < 400:
         for action in expert.act(obs):
             label = expert.labels[step] if step < len(expert.labels) else ""
             obs, *_ = env.step(action)
             step += 1
             labels.add(label)
-            if label in ("approach", "reach"):  # the jaws open beside the block: no touch
-                pressed = max(pressed, world.hand_force(arm))
+            if label in during:
+                felt = max(felt, world.hand_force(arm, other))
     env.close()
+    return labels, felt
+
+
+def test_the_z1s_fixed_jaw_stays_off_the_table_beside_a_low_block(tmp_path: Path) -> None:
+    """The Z1's fixed jaw reaches 2 cm past its TCP: a grasp low on a 3 cm block put its
+    tip on the table (280 N on the hand before the jaws closed)."""
+    from fsvla.env import make
+
+    path = tmp_path / "low_block.fsv"
+    path.write_text(LOW_BLOCK_Z1, encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    arm = world.arm_names[0]
+    assert world.hand_reach(arm) > 0.015  # the premise: the jaw reaches past the TCP
+    env.close()
+    # the jaws open beside the block: no touch on the way down
+    labels, pressed = _felt_until(path, "preclose", ("approach", "reach"))
     assert {"approach", "reach", "preclose"} <= labels
     assert pressed < 0.5, f"the hand pressed with {pressed:.1f} N on its way down"
-
 
 
 def test_a_leaning_hand_is_raised_until_its_lowest_jaw_corner_clears_the_table(
@@ -285,25 +301,8 @@ def test_a_hinged_jaw_closes_slowly_from_well_short_of_the_object(tmp_path: Path
     """The Z1's jaw closed quickly to 6 mm short of the bottle by its width model and met
     it there, its soft drive lagging the command: 149 N in one step. From 1.5 cm short,
     slowly, it meets the bottle with about 50 N."""
-    from fsvla.env import make
-    from fsvla.experts.policy import make_expert
-
     path = tmp_path / "bottle.fsv"
     path.write_text(BOTTLE_Z1, encoding="utf-8")
-    env = make(str(path), "L0", 0)
-    expert = make_expert(env, "careful")
-    obs, _ = env.reset()
-    expert.reset(None)
-    world = World.of_env(env)
-    step, labels, felt = 0, [], 0.0
-    while "lift" not in labels and step < 400:
-        for action in expert.act(obs):
-            label = expert.labels[step] if step < len(expert.labels) else ""
-            obs, *_ = env.step(action)
-            step += 1
-            labels.append(label)
-            if label in ("preclose", "close"):
-                felt = max(felt, world.hand_force("arm", "bottle"))
-    env.close()
+    labels, felt = _felt_until(path, "lift", ("preclose", "close"), "bottle")
     assert "close" in labels
     assert 0.0 < felt < 80.0, f"the jaw met the bottle with {felt:.0f} N"
