@@ -319,9 +319,7 @@ class World:
             return 1.0
         if width <= 0.0:
             return 0.0
-        if self.fingers_slide(arm):
-            return float(np.clip((width - self.closed_gap(arm)) / self.travel(arm), 0.0, 1.0))
-        if len(self.arm_spec(arm).gripper.finger_links) < 2:
+        if self.fingers_slide(arm) or len(self.arm_spec(arm).gripper.finger_links) < 2:
             return float(width / self.max_width(arm))
         kin = self.kinematics(arm)
         lo, hi = 0.0, 1.0
