@@ -69,6 +69,7 @@ class World:
         self._open_width: dict[str, float] = {}
         self._closed_gap: dict[str, float] = {}
         self._rigid: dict[str, frozenset[int]] = {}
+        self._hand_depth: dict[str, float] = {}
 
     @classmethod
     def of_env(cls, env: Any) -> World:
@@ -182,29 +183,26 @@ class World:
     def hand_depth(self, arm: str) -> float:
         """How far (m) below an object's top a top-down TCP may grip it, the hand's body (a
         Panda's, 37 mm above its TCP; Baxter's gripper base, 10 cm) clearing the top by
-        PALM_CLEARANCE: measured on the hulls of the hand's links other than its fingers.
-        A jaw on a hinge grips with its tips: HAND_DEPTH below the top, its gap narrowing
-        toward the hinge."""
+        PALM_CLEARANCE, to the millimetre: measured on the hulls of the hand's links other
+        than its fingers. A jaw on a hinge grips with its tips: HAND_DEPTH below the top,
+        its gap narrowing toward the hinge."""
+        if arm not in self._hand_depth:
+            self._hand_depth[arm] = self._measure_hand_depth(arm)
+        return self._hand_depth[arm]
+
+    def _measure_hand_depth(self, arm: str) -> float:
         if not self.fingers_slide(arm):
             return HAND_DEPTH
-        kin = self.kinematics(arm)
-        names = list(kin.link_names)
+        names = self.kinematics(arm).link_names
         fingers = set(self.arm_spec(arm).gripper.finger_links)
-        q = np.asarray(kin.spec.home, dtype=np.float64)
-        tcp = kin.tcp_pose(q)
-        back = -(quat_to_matrix(tcp.q) @ self.approach_axis(arm))
-        positions, quaternions = kin.link_poses(q, list(range(len(names))))
-        depth = None
-        for i in self.hand_rigid_links(arm):
-            vertices = kin.link_vertices(i)
-            if names[i] in fingers or vertices is None:
-                continue
-            points = vertices @ quat_to_matrix(quaternions[i]).T + np.asarray(positions[i])
-            lowest = float(np.min((points - np.asarray(tcp.p)) @ back))
-            depth = lowest if depth is None else min(depth, lowest)
-        if depth is None or depth <= PALM_CLEARANCE:
+        tcp = self.current_pose(arm)
+        back = -(tcp.R @ self.approach_axis(arm))
+        body = (self.link_points(arm, names[i]) for i in self.hand_rigid_links(arm)
+                if names[i] not in fingers)
+        depths = [float(np.min((points - tcp.p) @ back)) for points in body if points is not None]
+        if not depths or min(depths) <= PALM_CLEARANCE:
             return HAND_DEPTH
-        return math.floor((depth - PALM_CLEARANCE) * 1000.0) / 1000.0  # to the millimetre
+        return math.floor((min(depths) - PALM_CLEARANCE) * 1000.0) / 1000.0
 
     def base_position(self, arm: str) -> NDArray[np.float64]:
         base = self.state.robot_link_pose(arm, self.arm_spec(arm).base_link)

@@ -10,6 +10,8 @@ import pytest
 from fsvla.experts import rollout
 from fsvla.run.plan import layout_seed
 
+from .conftest import world_of
+
 pytestmark = pytest.mark.sim
 
 #: The sampler's draw 52 (``fsvla.validate.sampler``, seed 52) as it wrote it: Baxter stacks
@@ -75,20 +77,15 @@ scenario carry_to_the_far_side_baxter
 def test_the_arm_that_reaches_the_target_carries(tmp_path: Path) -> None:
     """The right arm is nearer the block but cannot hold its hand over the plate: it
     carried the block as far as it reached and stopped short. The left reaches both."""
-    from fsvla.env import make
     from fsvla.experts.skills import carrying_arm, nearest_arm
-    from fsvla.experts.world import World
 
     path = tmp_path / "far.fsv"
     path.write_text(FAR_SIDE_BAXTER, encoding="utf-8")
-    env = make(str(path), "L0", 0)
-    env.reset()
-    world = World.of_env(env)
-    assert nearest_arm(world, world.body_pose("block").p) == "right"
-    assert carrying_arm(world, "block", "plate") == "left"
-    # a target the nearest arm reaches: the nearest arm carries
-    assert carrying_arm(world, "plate", "block") == "left"
-    env.close()
+    with world_of(path) as world:
+        assert nearest_arm(world, world.body_pose("block").p) == "right"
+        assert carrying_arm(world, "block", "plate") == "left"
+        # a target the nearest arm reaches: the nearest arm carries
+        assert carrying_arm(world, "plate", "block") == "left"
 
 
 @pytest.mark.slow

@@ -13,6 +13,8 @@ from fsvla.experts.style import CAREFUL
 from fsvla.experts.world import HAND_DEPTH, World
 from fsvla.resources import scenarios_dir
 
+from .conftest import world_of
+
 pytestmark = pytest.mark.sim
 
 LIFT = """\
@@ -152,16 +154,10 @@ def _felt_until(path: Path, until: str, during: tuple[str, ...],
 def test_the_z1s_fixed_jaw_stays_off_the_table_beside_a_low_block(tmp_path: Path) -> None:
     """The Z1's fixed jaw reaches 2 cm past its TCP: a grasp low on a 3 cm block put its
     tip on the table (280 N on the hand before the jaws closed)."""
-    from fsvla.env import make
-
     path = tmp_path / "low_block.fsv"
     path.write_text(LOW_BLOCK_Z1, encoding="utf-8")
-    env = make(str(path), "L0", 0)
-    env.reset()
-    world = World.of_env(env)
-    arm = world.arm_names[0]
-    assert world.hand_reach(arm) > 0.015  # the premise: the jaw reaches past the TCP
-    env.close()
+    with world_of(path) as world:  # the premise: the jaw reaches past the TCP
+        assert world.hand_reach(world.arm_names[0]) > 0.015
     # the jaws open beside the block: no touch on the way down
     labels, pressed = _felt_until(path, "preclose", ("approach", "reach"))
     assert {"approach", "reach", "preclose"} <= labels
@@ -173,25 +169,21 @@ def test_a_leaning_hand_is_raised_until_its_lowest_jaw_corner_clears_the_table(
     """A grasp tilted 50 deg from the vertical was left where it was (only grasps within
     45 deg of it were raised, by the jaws' reach along the approach): the Z1's jaws, 8 cm
     wide, leaning over, reached below the table beside a low block."""
-    from fsvla.env import make
     from fsvla.experts import grasps
     from fsvla.experts.skills import TIP_GAP, UP, jaws_clear_of_support
 
     path = tmp_path / "low_block.fsv"
     path.write_text(LOW_BLOCK_Z1, encoding="utf-8")
-    env = make(str(path), "L0", 0)
-    env.reset()
-    world = World.of_env(env)
-    arm = world.arm_names[0]
-    bottom = float(world.bounds("block")[0][2])
-    for angle in (0.0, 35.0, 50.0):
-        grasp = grasps.tilted(world, arm, grasps.grasps(world, arm, "block")[0],
-                              float(np.deg2rad(angle)))
-        raised = jaws_clear_of_support(world, arm, "block", grasp)
-        lowest = raised.pose.p[2] - world.hand_front(arm, raised.pose.R, -UP, raised.pose.p,
-                                                     np.inf)
-        assert lowest >= bottom + TIP_GAP - 1e-6, (angle, lowest)
-    env.close()
+    with world_of(path) as world:
+        arm = world.arm_names[0]
+        bottom = float(world.bounds("block")[0][2])
+        for angle in (0.0, 35.0, 50.0):
+            grasp = grasps.tilted(world, arm, grasps.grasps(world, arm, "block")[0],
+                                  float(np.deg2rad(angle)))
+            raised = jaws_clear_of_support(world, arm, "block", grasp)
+            lowest = raised.pose.p[2] - world.hand_front(arm, raised.pose.R, -UP,
+                                                         raised.pose.p, np.inf)
+            assert lowest >= bottom + TIP_GAP - 1e-6, (angle, lowest)
 
 
 #: The sampler's draw 12 (``fsvla.validate.sampler``, seed 12): Baxter lifts a bottle whose
@@ -224,37 +216,27 @@ def test_shut_fingers_that_stay_apart_are_measured_on_their_hulls(tmp_path: Path
     different pair of tips); the width model, which puts the fingers' points together when
     shut, took the 1.6 cm neck of a bottle for something to squeeze, and the fingers closed
     on it without a touch. An SO-101's jaw is a hinge: no gap is measured."""
-    from fsvla.env import make
     from fsvla.experts import grasps
 
     path = tmp_path / "neck.fsv"
     path.write_text(THIN_NECK_BAXTER, encoding="utf-8")
-    env = make(str(path), "L0", 0)
-    env.reset()
-    world = World.of_env(env)
-    assert world.fingers_slide("left")
-    assert world.closed_gap("left") == pytest.approx(0.016, abs=0.002)
-    assert world.closed_gap("right") == pytest.approx(0.0065, abs=0.002)
-    # Baxter's fingers are 11 cm long: the body is gripped 9.4 cm below the top (the
-    # gripper base clears it by 9 mm), not 2.8 cm, where the neck is
-    assert world.hand_depth("left") == pytest.approx(0.094)
-    grasp = grasps.choose(world, CAREFUL, "left", "bottle")
-    assert grasp.width == pytest.approx(0.03)  # the body, not the neck
-    assert grasp.pose.p[2] == pytest.approx(0.183 - 0.094, abs=1e-3)
-    env.close()
-    env = make(str(scenario), "L0", 0)
-    env.reset()
-    world = World.of_env(env)
-    assert world.closed_gap("arm") == 0.0
-    assert world.hand_depth("arm") == HAND_DEPTH  # a jaw on a hinge grips with its tips
-    env.close()
-    env = make(str(scenarios_dir() / "force" / "lift_glass_gently.fsv"), "L0", 0)
-    env.reset()
-    world = World.of_env(env)
-    arm = world.arm_names[0]
-    assert world.closed_gap(arm) < 1e-3  # a Panda's fingers meet
-    assert world.hand_depth(arm) == pytest.approx(0.028)  # its hand's body 37 mm up
-    env.close()
+    with world_of(path) as world:
+        assert world.fingers_slide("left")
+        assert world.closed_gap("left") == pytest.approx(0.016, abs=0.002)
+        assert world.closed_gap("right") == pytest.approx(0.0065, abs=0.002)
+        # Baxter's fingers are 11 cm long: the body is gripped 9.4 cm below the top (the
+        # gripper base clears it by 9 mm), not 2.8 cm, where the neck is
+        assert world.hand_depth("left") == pytest.approx(0.094)
+        grasp = grasps.choose(world, CAREFUL, "left", "bottle")
+        assert grasp.width == pytest.approx(0.03)  # the body, not the neck
+        assert grasp.pose.p[2] == pytest.approx(0.183 - 0.094, abs=1e-3)
+    with world_of(scenario) as world:
+        assert world.closed_gap("arm") == 0.0
+        assert world.hand_depth("arm") == HAND_DEPTH  # a jaw on a hinge grips with its tips
+    with world_of(scenarios_dir() / "force" / "lift_glass_gently.fsv") as world:
+        arm = world.arm_names[0]
+        assert world.closed_gap(arm) < 1e-3  # a Panda's fingers meet
+        assert world.hand_depth(arm) == pytest.approx(0.028)  # its hand's body 37 mm up
 
 
 @pytest.mark.slow
