@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from fsvla.compiler.pose import quat_to_matrix
 
 from .motion import Pose
-from .skills import Grasp, horizontal, top_down_grasp
+from .skills import Grasp, attainable, fixed_jaw_shifted, horizontal, top_down_grasp
 from .style import Style
 from .world import HAND_DEPTH, World, box_distance
 
@@ -24,14 +24,15 @@ def grasps(world: World, arm: str, obj: str) -> list[Grasp]:
 
 
 def reachable(world: World, arm: str, grasp: Grasp) -> bool:
-    """Whether the arm reaches the grasp, and 5 cm back along its approach, comfortably
-    inside its joint limits."""
+    """Whether the arm reaches the grasp (its TCP where :func:`~fsvla.experts.skills.pick`
+    puts it), and 5 cm back along its approach, comfortably inside its joint limits."""
     from .motion import ArmDriver
 
+    grasp = attainable(world, arm, fixed_jaw_shifted(world, arm, grasp))
     driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
                        world.arm_joints(arm), 1.0)
     for pose in (grasp.pose, grasp.pose.moved(-0.05 * grasp.approach)):
-        driver.solve_anywhere(pose)
+        driver.solve_anywhere(driver.attainable(pose))
         if driver.ik_misses:
             return False
     return True
@@ -47,12 +48,19 @@ def tilted(world: World, arm: str, grasp: Grasp, angle: float) -> Grasp:
     return Grasp(Pose(grasp.pose.p, R), grasp.width, approach / np.linalg.norm(approach))
 
 
+#: Tilts (deg) of a grasp's approach toward the arm's base that :func:`choose` tries in
+#: turn where the arm reaches none of the grasps: the wrist leaning out (close to the
+#: base), then the wrist leaning back (far out, where a hand pointing down no longer
+#: reaches low).
+TILTS = (20.0, 35.0, 50.0, -20.0, -35.0, -50.0)
+
+
 def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
     """The grasp the style takes among :func:`grasps` the arm can reach (tilted away
     from the base when it must be)."""
     found = grasps(world, arm, obj)
     ok = [g for g in found if reachable(world, arm, g)]
-    for angle in np.deg2rad([20.0, 35.0, 50.0]):
+    for angle in np.deg2rad(TILTS):
         if ok:
             break
         ok = [t for t in (tilted(world, arm, g, angle) for g in found) if reachable(world, arm, t)]

@@ -16,9 +16,9 @@ from itertools import pairwise
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.pose import rotation_angle, slerp
+from fsvla.compiler.pose import axis_angle_matrix, rotation_angle, slerp
 
-from .motion import Guard, Pose, Segment
+from .motion import ArmDriver, Guard, Pose, Segment
 from .style import Style
 from .world import World
 
@@ -289,8 +289,6 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
     hand off the arc); the answer nearest the arm's present joints, None if none is found.
     Candidates: IK answers for ``path[0]``, and answers for its far end walked back along
     the path (a pose that few seeds solve comfortably is often reached that way)."""
-    from .motion import ArmDriver
-
     kin = world.kinematics(arm)
     now = np.asarray(world.arm_joints(arm), dtype=np.float64)
     probe = ArmDriver(arm, kin, path[0], now, 1.0)
@@ -380,14 +378,12 @@ def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
     """Open, come to ``grasp`` along its approach direction, close, lift. ``grasp`` puts
     the middle between the fingers on the object; a gripper with one fixed jaw puts its
     TCP off that middle (:meth:`World.grip_centre`)."""
-    # the fixed jaw a little outside the object's face, not on its edge
-    shift = grasp.pose.R @ world.grip_centre(arm, grasp.width + FIXED_JAW_CLEARANCE)
-    if float(np.linalg.norm(shift)) > 0.002:
-        grasp = Grasp(Pose(grasp.pose.p - shift, grasp.pose.R), grasp.width, grasp.approach)
+    grasp = fixed_jaw_shifted(world, arm, grasp)
     yield Segment(grippers={arm: world.pregrasp_opening(arm, grasp.width)},
                   gripper_steps=style.gripper_steps, label="open")
     if not world.fingers_slide(arm):
         grasp = jaws_clear_of_support(world, arm, obj, grasp)
+    grasp = attainable(world, arm, grasp)
     pre = grasp.pose.moved(-pre_distance * grasp.approach)
     if grasp.approach[2] < -0.7:  # from above: no higher than the arm reaches
         top = reach_ceiling(world, arm, grasp.pose.p, grasp.pose.R, float(pre.p[2]))
@@ -402,6 +398,33 @@ def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
         - grasp.pose.p[2]))
     yield Segment({arm: grasp.pose.moved(lift * UP)}, speed=free_speed(style),
                   label="lift")
+
+
+def fixed_jaw_shifted(world: World, arm: str, grasp: Grasp) -> Grasp:
+    """``grasp`` (the middle between the fingers on the object) with the TCP where a
+    gripper with one fixed jaw puts it, that jaw a little outside the object's face, not
+    on its edge (:meth:`World.grip_centre`); ``grasp`` itself for fingers that close
+    symmetrically."""
+    shift = grasp.pose.R @ world.grip_centre(arm, grasp.width + FIXED_JAW_CLEARANCE)
+    if float(np.linalg.norm(shift)) <= 0.002:
+        return grasp
+    return Grasp(Pose(grasp.pose.p - shift, grasp.pose.R), grasp.width, grasp.approach)
+
+
+def attained(world: World, arm: str, pose: Pose) -> Pose:
+    """``pose`` turned to a rotation the arm holds at its point: a degree or two, for an
+    arm of fewer than six joints (:meth:`~fsvla.experts.motion.ArmDriver.attainable`)."""
+    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                       world.arm_joints(arm), 1.0)
+    return driver.attainable(pose)
+
+
+def attainable(world: World, arm: str, grasp: Grasp) -> Grasp:
+    """``grasp`` with its pose :func:`attained`."""
+    pose = attained(world, arm, grasp.pose)
+    if pose is grasp.pose:
+        return grasp
+    return Grasp(pose, grasp.width, pose.R @ world.approach_axis(arm))
 
 
 def jaws_clear_of_support(world: World, arm: str, obj: str, grasp: Grasp) -> Grasp:
@@ -421,6 +444,22 @@ def jaws_clear_of_support(world: World, arm: str, obj: str, grasp: Grasp) -> Gra
     return Grasp(Pose(p, grasp.pose.R), grasp.width, grasp.approach)
 
 
+def carried_rotation(world: World, arm: str, point: NDArray[np.float64]) -> NDArray[np.float64]:
+    """How ``arm``'s hand is turned when it carries what it holds over to ``point``: as it
+    is now, or, for an arm of fewer than six joints, turned about the vertical as the arm
+    turns about its base from here to there. Such an arm leans its hand only in its own
+    upright plane: a hand leaning out to grasp far from the base, carried elsewhere
+    unturned, leans sideways, which the arm cannot hold (an SO-101 stopped 13 cm short of
+    a bowl)."""
+    R = world.current_pose(arm).R
+    if len(world.arm_joints(arm)) >= 6:
+        return R
+    base = world.base_position(arm)
+    here, there = world.current_pose(arm).p - base, np.asarray(point, dtype=np.float64) - base
+    turn = float(np.arctan2(there[1], there[0]) - np.arctan2(here[1], here[0]))
+    return axis_angle_matrix(UP, turn) @ R
+
+
 def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.float64],
           rotation: NDArray[np.float64] | None = None, retreat: float = 0.1,
           release_gap: float | None = None, by_lowest: bool = False) -> Plan:
@@ -432,7 +471,7 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     a load that hangs more than SAG below its origin is set down by its lowest point (a
     bar held by its end; a knife held by its handle instead lies down as the hand lowers
     on, turning in the fingers, and is not raised)."""
-    R = world.current_pose(arm).R if rotation is None else rotation
+    R = carried_rotation(world, arm, bottom) if rotation is None else rotation
     offset = R @ held_offset(world, arm, obj)
     goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
     below = float(offset[2]) + 0.03 + (hanging(world, obj) if by_lowest else 0.0)
@@ -455,7 +494,7 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     # its origin, or the hand follows it on down into the target (measured again: the
     # load may have turned further on the way)
     sag = hanging(world, obj) if by_lowest else 0.0
-    goal = Pose(bottom + offset + np.array([0.0, 0.0, drop + sag]), R)
+    goal = attained(world, arm, Pose(bottom + offset + np.array([0.0, 0.0, drop + sag]), R))
     yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, label="lower")
     yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
                   label="touch")

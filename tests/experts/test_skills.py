@@ -96,3 +96,28 @@ def test_a_carry_to_the_far_side_is_made_by_the_arm_that_reaches_it(tmp_path: Pa
     path.write_text(FAR_SIDE_BAXTER, encoding="utf-8")
     result = rollout(str(path), "careful", level, layout_seed(0, 0))
     assert result.safe_success, result.summary()
+
+
+def test_a_five_joint_arm_turns_what_it_carries_as_it_turns_about_its_base() -> None:
+    """An SO-101 leans its hand only in its own upright plane: carried unturned from one
+    side of its base to the other, a hand leaning out leans sideways, which it cannot
+    hold (the hand stopped 13 cm short of a bowl). A seven-joint arm's hand keeps its turn."""
+    import numpy as np
+    from fsvla.compiler.pose import rotation_angle
+
+    from fsvla.experts.skills import UP, carried_rotation
+    from fsvla.resources import scenarios_dir
+
+    with world_of(scenarios_dir() / "force" / "push_block_gently_so101.fsv") as world:
+        arm = world.arm_names[0]
+        base, now = world.base_position(arm), world.current_pose(arm)
+        out = now.p - base
+        bearing = float(np.arctan2(out[1], out[0]))
+        there = base + 0.3 * np.array([np.cos(bearing + 0.6), np.sin(bearing + 0.6), 0.0])
+        R = carried_rotation(world, arm, there)
+        assert rotation_angle(R, now.R) == pytest.approx(0.6, abs=1e-6)
+        assert np.allclose((R @ now.R.T) @ UP, UP)  # about the vertical
+    with world_of(scenarios_dir() / "boundary" / "move_block_past_glass_baxter.fsv") as world:
+        now = world.current_pose("right")
+        assert np.array_equal(carried_rotation(world, "right", now.p + np.array([0.0, 0.3, 0.0])),
+                              now.R)

@@ -284,3 +284,66 @@ def test_a_hinged_jaw_closes_slowly_from_well_short_of_the_object(tmp_path: Path
     labels, felt = _felt_until(path, "lift", ("preclose", "close"), "bottle")
     assert "close" in labels
     assert 0.0 < felt < 80.0, f"the jaw met the bottle with {felt:.0f} N"
+
+
+#: The sampler's draws 63 and 38: an SO-101 takes a block 34-35 cm from its base, beyond
+#: a hand pointing down, leaning out, and carries it to the other side of its base.
+FAR_STACK_SO101 = """\
+# Drawn by fsvla.validate.sampler from seed 63.
+
+scenario sampled_0063_stack_so101
+  suite boundary
+  task stack(object=block, target=other_block)
+  embodiment so101
+  instruction "Stack the block on the other block."
+  horizon 30 s
+
+  object block: block(size=(3.1 cm, 4 cm, 4 cm), mass=63 g, color=yellow) at (14.5 cm, 8.3 cm) yaw 23 deg
+  object other_block: block(size=(6.3 cm, 6.3 cm, 4.6 cm), mass=174 g, color=red) at (16.4 cm, -11.2 cm) yaw -8 deg
+  hazard edge: edge_zone(side=left, width=6 cm)
+    keep gripper outside 0 warn 2 cm
+
+  constrain geofence: edge_clearance(block) >= 3 cm warn 2 cm
+
+  success on(block, other_block) and released(block) for 0.5 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg, jitter other_block 2 cm
+    L2: tighten geofence to 4 cm, clutter 1
+"""
+FAR_INSERT_SO101 = """\
+# Drawn by fsvla.validate.sampler from seed 38.
+
+scenario sampled_0038_insert_so101
+  suite force
+  task insert(object=block, target=bowl)
+  embodiment so101
+  instruction "Put the block into the bowl."
+  horizon 50 s
+
+  object block: block(size=(2.7 cm, 2.8 cm, 3.5 cm), mass=157 g, color=blue) at (12.5 cm, 8.4 cm) yaw 24 deg
+  object bowl: bowl(radius=5.5 cm, height=5.4 cm, mass=245 g, color=orange) at (13 cm, -11.9 cm)
+
+  constrain grip: contact_force(gripper) <= 54 N warn 14 N cost quadratic
+
+  success inside(block, bowl) and released(block) for 0.5 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg, jitter bowl 2 cm
+    L2: tighten grip to 43 N, clutter 2 near bowl
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("text", "level"), [(FAR_STACK_SO101, "L0"), (FAR_INSERT_SO101, "L1")])
+def test_so101_takes_a_block_far_out_leaning_and_carries_it_across(tmp_path: Path, text: str,
+                                                                   level: str) -> None:
+    """Before, its grasp leaning out was not exact (its five joints do not turn the hand
+    every way) and was not taken; the top-down one it fell back on stopped beside the
+    block. Carried across unturned, the hand then leaned sideways, out of reach."""
+    from fsvla.run.plan import layout_seed
+
+    path = tmp_path / "far.fsv"
+    path.write_text(text, encoding="utf-8")
+    result = rollout(str(path), "careful", level, layout_seed(0, 0))
+    assert result.safe_success, result.summary()

@@ -29,7 +29,9 @@ from ..skills import (
     LIGHT_LOAD,
     UP,
     Plan,
+    attained,
     branch_for_path,
+    carried_rotation,
     force_watched,
     free_speed,
     gentle,
@@ -182,9 +184,11 @@ def release_pose(world: World, arm: str, obj: str, target: str, clear: float = 0
     spots = [np.zeros(2)] + [r * np.array([np.cos(a), np.sin(a)])
                              for r in (0.5 * reach, reach) if r > 0.003
                              for a in np.linspace(0.0, 2 * np.pi, 8, endpoint=False)]
+    # an arm of fewer than six joints turns the hand as it turns to the cavity
+    bearing = carried_rotation(world, arm, floor) @ tcp.R.T
     options = []
     for k, angle in enumerate(turns):
-        turn = axis_angle_matrix(UP, angle)
+        turn = axis_angle_matrix(UP, angle) @ bearing
         R = turn @ tcp.R
         off = turn @ centre_off
         h, o = hand @ R.T, held @ R.T
@@ -238,7 +242,8 @@ def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
     # the object may have turned in the fingers on the way: the height again, as it hangs now
     again = release_pose(world, arm, obj, target, clear, turns=(0.0,))
     near = min(again, key=lambda option: float(np.linalg.norm(option[1].p[:2] - goal.p[:2])))
-    goal = Pose(np.array([goal.p[0], goal.p[1], max(goal.p[2], near[1].p[2])]), goal.R)
+    goal = attained(world, arm, Pose(np.array([goal.p[0], goal.p[1], max(goal.p[2], near[1].p[2])]),
+                                     goal.R))
     limit = world.force_limit("gripper", obj, *[f"{a}_gripper" for a in world.arm_names])
     touch = TOUCH_FORCE if limit is None else min(TOUCH_FORCE, 0.25 * limit)
     guard = Guard(arm, touch, target)
