@@ -162,6 +162,13 @@ class SceneState(Protocol):
         the body ``other`` when given); contacts between robot links are left out."""
         ...
 
+    def contact_gap(self, arm: str, links: Sequence[str], other: str) -> float | None:
+        """How far (m) the nearest of ``arm``'s robot ``links`` is from the body ``other``
+        (negative: into it) where the simulator tracks the two as in contact, within its
+        contact distance; None where they are farther apart. A proximity sensor on the
+        fingers."""
+        ...
+
 
 # --- monitoring --------------------------------------------------------------------------
 

@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from fsvla.compiler.pose import quat_to_matrix
 
 from .motion import Pose
-from .skills import Grasp, attainable, fixed_jaw_shifted, horizontal, top_down_grasp
+from .skills import DOWN, Grasp, attainable, fixed_jaw_shifted, horizontal, top_down_grasp
 from .style import Style
 from .world import HAND_DEPTH, World, box_distance
 
@@ -114,10 +114,15 @@ PAD_HALF = 0.01
 def _grip_height(world: World, arm: str, obj: str, h: float) -> tuple[float, float] | None:
     """Where a top-down hand grips an upright object made of cylinder pieces: the TCP's
     height above the object's base, as low as the palm still clears the object's top
-    (:meth:`World.hand_depth`), with the pads on one upright cylinder piece narrower than
+    (:meth:`World.hand_depth`), with the pads (a jaw on a hinge: the whole jaw, as far as
+    it reaches below the TCP) on one upright cylinder piece narrower than
     the gripper opens and wider than its shut fingers leave (the highest such piece), and
     that piece's width; None when no piece fits."""
     low = h - world.hand_depth(arm)  # the palm clears the top
+    # the whole jaw on the piece: a fixed jaw reaches below the TCP (a Z1's by 2.3 cm, onto
+    # a bottle's shoulder below its neck, which it slides up and off as the hand rises)
+    reach = PAD_HALF if world.fingers_slide(arm) else max(PAD_HALF, world.hand_front(
+        arm, world.grasp_frame(arm, DOWN, np.array([1.0, 0.0, 0.0])), DOWN, np.zeros(3), np.inf))
     found: list[tuple[float, float, float]] = []
     for shape in world.asset(obj).collision:
         if shape.type != "cylinder" or 2 * shape.radius >= 0.92 * world.max_width(arm) \
@@ -127,7 +132,7 @@ def _grip_height(world: World, arm: str, obj: str, h: float) -> tuple[float, flo
         z, half = float(shape.pose.position[2]), float(shape.half_length)
         found.append((z + half, z - half, 2 * float(shape.radius)))
     for top, bottom, width in sorted(found, reverse=True):
-        height = max(low, bottom + PAD_HALF)
+        height = max(low, bottom + reach)
         if height <= top - PAD_HALF:
             return height, width
     return None

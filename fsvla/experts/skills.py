@@ -57,6 +57,11 @@ SLOW_CLOSE = 0.005
 #: sliding fingers, whose opening is their travel; a jaw on a hinge, whose gap where it
 #: meets the object is not the one at its tips that the width model gives (a Z1's jaw met
 #: a bottle before its tips were 6 mm from it, and squeezed it at 150 N in one step).
+#: :func:`creep_shut`: within this gap (m) of the object a jaw closes slower than
+#: SLOW_CLOSE, down to CREEP_STEP of its range a step; at most CREEP_STEPS steps.
+CREEP_GAP = 0.004
+CREEP_STEP = 0.0005
+CREEP_STEPS = 400
 PRECLOSE_GAP = 0.006
 PRECLOSE_GAP_HINGED = 0.015
 #: How close (m) the tips of a jaw on a hinge may come to what a grasped object stands on.
@@ -436,7 +441,8 @@ def jaws_clear_of_support(world: World, arm: str, obj: str, grasp: Grasp) -> Gra
     if grasp.approach[2] > -0.3:
         return grasp
     below = world.hand_front(arm, grasp.pose.R, -UP, grasp.pose.p, np.inf)
-    floor = float(world.bounds(obj)[0][2]) + below + TIP_GAP
+    # never below the table (z = 0): a knife just set down, settling, reads 8 mm into it
+    floor = max(0.0, float(world.bounds(obj)[0][2])) + below + TIP_GAP
     if grasp.pose.p[2] >= floor:
         return grasp
     p = grasp.pose.p.copy()
@@ -545,10 +551,16 @@ def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj:
         near = {arm: world.opening_fraction(arm, widths[arm] + preclose_gap(world, arm))
                 for arm in widths}
         yield Segment(grippers=near, gripper_steps=style.gripper_steps, label="preclose")
-        steps = max([2 * style.gripper_steps] + [
-            int(np.ceil((near[arm] - target[arm]) / SLOW_CLOSE)) for arm in widths])
-        yield Segment(grippers=target, gripper_steps=steps, settle=style.settle,
-                      guards=tuple(guard.values()), label="close")
+        # a jaw on a hinge under a contact-force limit creeps onto the object; without
+        # one, its squeeze at SLOW_CLOSE holds better than the guard's own force would
+        hands = ("gripper", *[f"{arm}_gripper" for arm in world.arm_names])
+        if all(world.fingers_slide(arm) for arm in widths) or world.force_limit(obj, *hands) is None:
+            steps = max([2 * style.gripper_steps] + [
+                int(np.ceil((near[arm] - target[arm]) / SLOW_CLOSE)) for arm in widths])
+            yield Segment(grippers=target, gripper_steps=steps, settle=style.settle,
+                          guards=tuple(guard.values()), label="close")
+        else:
+            yield from creep_shut(world, style, obj, near, target, guard)
     else:
         yield Segment(grippers=target, gripper_steps=style.gripper_steps,
                       settle=style.settle, guards=tuple(guard.values()), label="close")
@@ -561,6 +573,33 @@ def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj:
         yield Segment(grippers={arm: min(1.0, world.gripper_opening(arm) + EASE_STEP)
                                 for arm in tight}, gripper_steps=1, settle=2, label="ease")
     yield from squeeze_until_felt(world, style, force, obj, target)
+
+
+def creep_shut(world: World, style: Style, obj: str, start: Mapping[str, float],
+               target: Mapping[str, float], guard: Mapping[str, Guard]) -> Plan:
+    """Close the grippers of the arms in ``start`` from there (opening, arm -> [0, 1])
+    toward ``target`` a control step at a time, each stopping where its ``guard`` feels
+    its force: by SLOW_CLOSE of the range a step while its fingers are more than
+    CREEP_GAP from squeezing ``obj`` (:meth:`World.grip_gap`), slower as the gap closes,
+    and CREEP_STEP once they squeeze it. A stiff jaw drive whose command leads the jaw
+    meets the object with the squeeze of that lead in one step (a Z1's: 30-40 N at
+    SLOW_CLOSE; creeping, about 11 N)."""
+    opening = dict(start)
+    for _ in range(CREEP_STEPS):
+        moving = {}
+        for arm, now in opening.items():
+            if now <= target[arm] or world.hand_force(arm, obj) >= guard[arm].force:
+                continue
+            gap = world.grip_gap(arm, obj)
+            rate = SLOW_CLOSE if gap is None or gap >= CREEP_GAP else \
+                max(CREEP_STEP, SLOW_CLOSE * max(0.0, gap) / CREEP_GAP)
+            moving[arm] = max(target[arm], now - rate)
+        opening.update(moving)
+        if not moving:
+            break
+        yield Segment(grippers=moving, gripper_steps=1, guards=tuple(guard[a] for a in moving),
+                      label="close")
+    yield Segment(settle=style.settle, label="close")
 
 
 def squeeze_until_felt(world: World, style: Style, force: Mapping[str, float], obj: str,

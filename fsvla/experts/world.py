@@ -290,6 +290,18 @@ class World:
         gap = min(sides[True]) - max(sides[False])
         return max(0.0, gap - self.gripper_opening(arm) * self.travel(arm))
 
+    def grip_gap(self, arm: str, obj: str) -> float | None:
+        """How far (m) ``arm``'s fingers have still to close before they squeeze ``obj``:
+        the sum of each finger's gap to it, read within the simulator's contact distance
+        (a few millimetres); None where a finger is farther. A jaw that meets the object
+        first pushes it across to the other (an SO-101's or a Z1's fixed jaw stands a few
+        millimetres off), and the squeeze begins only when both touch."""
+        gaps = [self.state.contact_gap(arm, (finger,), obj)
+                for finger in self.arm_spec(arm).gripper.finger_links]
+        if any(gap is None for gap in gaps):
+            return None
+        return sum(max(0.0, gap) for gap in gaps)
+
     def fingers_slide(self, arm: str) -> bool:
         """Whether the fingers' opening is their joints' travel (parallel sliding fingers
         that meet when closed, as a Panda hand's), not a jaw on a hinge or fingers that

@@ -181,11 +181,7 @@ class BuiltScene:
                 if link.name in links}
         robot = {link for articulation in self.robot.articulations.values()
                  for link in articulation.links}
-        source: set[Any] | None = None
-        if other in self.bodies:
-            source = {_rigid_component(self.bodies[other])}
-        elif other is not None:
-            source = set(self.articulations[other].links)
+        source = self._components_of(other)
         totals: dict[str, NDArray[np.float64]] = {}
         for contact in self.scene.get_contacts():
             b0, b1 = contact.bodies
@@ -196,6 +192,23 @@ class BuiltScene:
                         total += sign * np.asarray(point.impulse, dtype=np.float64)
         inv_dt = 1.0 / self.spec.physics.timestep
         return max((float(np.linalg.norm(t)) * inv_dt for t in totals.values()), default=0.0)
+
+    def contact_gap(self, arm: str, links: Sequence[str], other: str) -> float | None:
+        mine = {link for link in self.robot.arm(arm).articulation.links if link.name in links}
+        source = self._components_of(other) or set()
+        gaps = [float(point.separation) for contact in self.scene.get_contacts()
+                if (contact.bodies[0] in mine and contact.bodies[1] in source)
+                or (contact.bodies[1] in mine and contact.bodies[0] in source)
+                for point in contact.points]
+        return min(gaps, default=None)
+
+    def _components_of(self, body: str | None) -> set[Any] | None:
+        """The physics components of the scene body or articulation ``body`` (None: any)."""
+        if body in self.bodies:
+            return {_rigid_component(self.bodies[body])}
+        if body is not None:
+            return set(self.articulations[body].links)
+        return None
 
     # --- fsvla.world.MonitoredScene: what the safety monitor reads -------------------------
     def frames(self) -> list[str]:

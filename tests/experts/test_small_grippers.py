@@ -286,6 +286,73 @@ def test_a_hinged_jaw_closes_slowly_from_well_short_of_the_object(tmp_path: Path
     assert 0.0 < felt < 80.0, f"the jaw met the bottle with {felt:.0f} N"
 
 
+def test_a_hinged_jaw_under_a_force_limit_creeps_onto_the_object(tmp_path: Path) -> None:
+    """Closing at SLOW_CLOSE, the Z1's stiff jaw drive led the jaw by the squeeze it met
+    the bottle with: 30-50 N in one step, against a 47 N limit. It now reads how far its
+    jaws are from squeezing the bottle, within the simulator's contact distance, and
+    slows as that closes: about 11 N."""
+    path = tmp_path / "bottle.fsv"
+    path.write_text(BOTTLE_Z1, encoding="utf-8")
+    labels, felt = _felt_until(path, "lift", ("close",), "bottle")
+    assert "lift" in labels
+    assert 0.0 < felt < 20.0, f"the jaw met the bottle with {felt:.0f} N"
+
+
+def test_a_fixed_jaw_that_reaches_past_the_tcp_grips_on_one_piece(tmp_path: Path) -> None:
+    """The Z1's fixed jaw reaches 2 cm past its TCP. Gripping the bottle's neck 1.1 cm
+    above its shoulder, it pressed on the shoulder's cone and slid up off it as the hand
+    rose: the bottle stayed on the table. The whole jaw now grips the neck."""
+    from fsvla.experts.grasps import PAD_HALF, grasps
+
+    path = tmp_path / "bottle.fsv"
+    path.write_text(BOTTLE_Z1, encoding="utf-8")
+    with world_of(path) as world:
+        arm = world.arm_names[0]
+        neck = min((s for s in world.asset("bottle").collision if s.type == "cylinder"),
+                   key=lambda s: s.radius)
+        bottom = float(neck.pose.position[2] - neck.half_length)
+        top = float(neck.pose.position[2] + neck.half_length)
+        for grasp in grasps(world, arm, "bottle"):
+            height = float(grasp.pose.p[2] - world.body_pose("bottle").p[2])
+            assert bottom + 0.019 <= height <= top - PAD_HALF, (bottom, height, top)
+
+
+#: The sampler's draw 49: a Z1 takes a knife by its handle. The knife, settling as the
+#: episode starts, reads 8 mm into the table.
+KNIFE_Z1 = """\
+# Drawn by fsvla.validate.sampler from seed 49.
+
+scenario sampled_0049_insert_z1
+  suite force
+  task insert(object=knife, target=pot)
+  embodiment z1
+  instruction "Put the knife into the pot."
+  horizon 50 s
+
+  object knife: knife(length=18.1 cm, color=purple) at (18.7 cm, -17.4 cm) yaw -6 deg
+  object pot: pot(radius=9.7 cm, height=8.9 cm, mass=224 g, color=blue) at (30.9 cm, 23 cm)
+
+  constrain grip: contact_force(gripper) <= 46 N warn 12 N cost quadratic
+
+  success inside(knife, pot) and released(knife) for 0.5 s
+
+  variants
+    L1: jitter knife 2 cm yaw 15 deg, jitter pot 2 cm
+    L2: tighten grip to 37 N, clutter 2 near pot
+"""
+
+
+def test_the_z1s_fixed_jaw_stays_off_the_table_over_a_knife_settling_into_it(
+        tmp_path: Path) -> None:
+    """The grasp was raised to keep the fixed jaw off what the knife stands on, read as
+    its lowest point: 8 mm below the table then. The jaw pressed on the table with 83 N."""
+    path = tmp_path / "knife.fsv"
+    path.write_text(KNIFE_Z1, encoding="utf-8")
+    labels, felt = _felt_until(path, "preclose", ("approach", "reach"))
+    assert "reach" in labels
+    assert felt < 5.0, f"the hand pressed with {felt:.0f} N before closing"
+
+
 #: The sampler's draws 63 and 38: an SO-101 takes a block 34-35 cm from its base, beyond
 #: a hand pointing down, leaning out, and carries it to the other side of its base.
 FAR_STACK_SO101 = """\
