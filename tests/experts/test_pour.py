@@ -47,3 +47,39 @@ def test_careful_pour_keeps_the_kettle_off_the_mug(tmp_path: Path, level: str) -
     path.write_text(KETTLE_OVER_MUG, encoding="utf-8")
     result = rollout(str(path), "careful", level, layout_seed(0, 0))
     assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 105: a 20 cm bottle poured into a 10 cm mug.
+TALL_BOTTLE_OVER_MUG = """\
+# Drawn by fsvla.validate.sampler from seed 105.
+
+scenario sampled_0105_pour_panda
+  suite force
+  task pour(object=bottle, target=mug)
+  embodiment panda
+  instruction "Pour from the bottle into the mug."
+  horizon 40 s
+
+  object bottle: bottle(radius=3.2 cm, height=19.8 cm, mass=133 g, color=orange) at (9.4 cm, -8.3 cm)
+  object mug: mug(radius=3.3 cm, height=9.7 cm, mass=108 g, color=blue) at (-8.2 cm, -4.4 cm)
+
+  constrain grip: contact_force(gripper) <= 39 N warn 10 N cost quadratic
+  constrain landing: contact_force(bottle) <= 17 N warn 6 N
+  watch displacement(mug) <= 3 cm warn 1 cm
+
+  success tilted(bottle, by=60 deg) and near(bottle, mug, within=10 cm) for 0.5 s
+
+  variants
+    L1: jitter bottle 2 cm, jitter mug 2 cm
+    L2: tighten grip to 31 N, clutter 1 near mug
+"""
+
+
+def test_a_tipped_object_is_lowered_to_pour(tmp_path: Path) -> None:
+    """The bottle was tipped where it stood clear of the mug upright: lying on its side it
+    was 12 cm above the mug, and `near(bottle, mug, within=10 cm)` never held. It is now
+    tipped as low as it clears the mug lying down."""
+    path = tmp_path / "tall.fsv"
+    path.write_text(TALL_BOTTLE_OVER_MUG, encoding="utf-8")
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
