@@ -6,6 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from fsvla.resources import scenarios_dir
+
+from .conftest import world_of
+
 pytestmark = pytest.mark.sim
 
 
@@ -43,14 +47,8 @@ LOWER = (-0.26, -0.64, 0.89, 2.02, -0.46, 0.31, -2.64)
 
 @pytest.fixture
 def baxter():
-    from fsvla.env import make
-    from fsvla.experts.world import World
-    from fsvla.resources import scenarios_dir
-
-    env = make(str(scenarios_dir() / "boundary" / "move_block_past_glass_baxter.fsv"), "L0", 0)
-    env.reset()
-    yield World.of_env(env)
-    env.close()
+    with world_of(scenarios_dir() / "boundary" / "move_block_past_glass_baxter.fsv") as world:
+        yield world
 
 
 def test_a_free_space_goal_out_of_reach_ends_where_the_hand_comes_closest(baxter) -> None:
@@ -85,14 +83,8 @@ def test_a_joint_space_move_that_would_dip_into_the_table_goes_by_way_of_home(ba
 
 @pytest.fixture
 def so101():
-    from fsvla.env import make
-    from fsvla.experts.world import World
-    from fsvla.resources import scenarios_dir
-
-    env = make(str(scenarios_dir() / "force" / "push_block_gently_so101.fsv"), "L0", 0)
-    env.reset()
-    yield World.of_env(env)
-    env.close()
+    with world_of(scenarios_dir() / "force" / "push_block_gently_so101.fsv") as world:
+        yield world
 
 
 @pytest.mark.parametrize(("yaw", "closing"), [(-0.25, 1.7), (0.2, 0.5)])
