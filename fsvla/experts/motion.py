@@ -184,10 +184,11 @@ class ArmDriver:
         """``pose`` turned, by a degree or two, to a rotation the arm holds at its point;
         ``pose`` itself for an arm of six joints or more, or where none is found within
         ATTAIN_TURN. An arm of fewer cannot turn its hand every way at a point, and the
-        solver's answer then gives up position rather than turn (an SO-101's grasp leaning
-        out, 35 cm from its base, ended 1.3 cm beside the block). Each round takes the rotation the answer
-        holds, and as far again beyond it (half the miss went each round without; with
-        it, one or two rounds reach a tenth of a millimetre)."""
+        solver's answer then gives up position rather than turn (an SO-101's grasp
+        leaning out, 35 cm from its base, ended 1.3 cm beside the block). Each round
+        takes the rotation the answer holds, and as far again beyond it (half the miss
+        went each round without; with it, one or two rounds reach a tenth of a
+        millimetre)."""
         if len(self.q) >= 6:
             return pose
         q, R = copy.copy(self).solve_anywhere(pose), pose.R
