@@ -57,13 +57,13 @@ SLOW_CLOSE = 0.005
 #: sliding fingers, whose opening is their travel; a jaw on a hinge, whose gap where it
 #: meets the object is not the one at its tips that the width model gives (a Z1's jaw met
 #: a bottle before its tips were 6 mm from it, and squeezed it at 150 N in one step).
+PRECLOSE_GAP = 0.006
+PRECLOSE_GAP_HINGED = 0.015
 #: :func:`creep_shut`: within this gap (m) of the object a jaw closes slower than
 #: SLOW_CLOSE, down to CREEP_STEP of its range a step; at most CREEP_STEPS steps.
 CREEP_GAP = 0.004
 CREEP_STEP = 0.0005
 CREEP_STEPS = 400
-PRECLOSE_GAP = 0.006
-PRECLOSE_GAP_HINGED = 0.015
 #: How close (m) the tips of a jaw on a hinge may come to what a grasped object stands on.
 TIP_GAP = 0.004
 #: How far (m) beyond a pose, away from the arm's base, the arm must still reach for the
