@@ -115,9 +115,9 @@ def _grip_height(world: World, arm: str, obj: str, h: float) -> tuple[float, flo
     """Where a top-down hand grips an upright object made of cylinder pieces: the TCP's
     height above the object's base, as low as the palm still clears the object's top
     (:meth:`World.hand_depth`), with the pads (a jaw on a hinge: the whole jaw, as far as
-    it reaches below the TCP) on one upright cylinder piece narrower than
-    the gripper opens and wider than its shut fingers leave (the highest such piece), and
-    that piece's width; None when no piece fits."""
+    it reaches below the TCP) on one upright cylinder piece narrower than the gripper
+    opens and wider than its shut fingers leave (the highest such piece), and that
+    piece's width; None when no piece fits."""
     low = h - world.hand_depth(arm)  # the palm clears the top
     # the whole jaw on the piece: a fixed jaw reaches below the TCP (a Z1's by 2.3 cm, onto
     # a bottle's shoulder below its neck, which it slides up and off as the hand rises)
