@@ -240,9 +240,16 @@ def _turning_grip(world: World, arm: str, now: float, angle: float,
     def at(psi_a: float, psi_b: float, flip: bool) -> Callable[[float], Pose]:
         out = max(inner(p) for p in (psi_a, psi_b, *psis)
                   if min(psi_a, psi_b) <= p <= max(psi_a, psi_b))
+        first = turn(psi_a, flip) @ world.finger_axis(arm)
 
         def pose_at(theta: float) -> Pose:
-            return pose(turn(psi_on(psi_a, psi_b, theta), flip), out, theta)
+            R = turn(psi_on(psi_a, psi_b, theta), flip)
+            # the same finger on the same end of the knob all along: `turn` takes the
+            # side nearer a hand pointing down, which changes along a long arc (the hand
+            # then rolled half a turn on the knob it pinched, and the lid stayed put)
+            if (R @ world.finger_axis(arm)) @ first < 0.0:
+                R = R @ axis_angle_matrix(world.approach_axis(arm), np.pi)
+            return pose(R, out, theta)
         return pose_at
 
     def psi_on(psi_a: float, psi_b: float, theta: float) -> float:
