@@ -31,11 +31,10 @@ def reachable(world: World, arm: str, grasp: Grasp) -> bool:
     grasp = attainable(world, arm, fixed_jaw_shifted(world, arm, grasp))
     driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
                        world.arm_joints(arm), 1.0)
-    for pose in (grasp.pose, grasp.pose.moved(-0.05 * grasp.approach)):
-        driver.solve_anywhere(driver.attainable(pose))
-        if driver.ik_misses:
-            return False
-    return True
+    driver.solve_anywhere(grasp.pose)
+    if not driver.ik_misses:
+        driver.solve_anywhere(driver.attainable(grasp.pose.moved(-0.05 * grasp.approach)))
+    return not driver.ik_misses
 
 
 def tilted(world: World, arm: str, grasp: Grasp, angle: float) -> Grasp:

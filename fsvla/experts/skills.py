@@ -132,8 +132,8 @@ def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
     need = max(need, weight_factor * mass * 9.81 * lever / (2 * 0.5 * PAD_RADIUS),
                weight_factor * mass * 9.81 * tip / PAD_TIP_ARM)
     force = max(need, style.grip_force)
+    names = {obj, *world.gripper_entities}
     for channel in world.monitor.channels:
-        names = {"gripper", obj, *[f"{a}_gripper" for a in world.arm_names]}
         if channel.metric == "contact_force" and set(channel.subjects) & names:
             # half the limit, and out of its warning band unless holding the object
             # needs more (a tightened limit): then inside the band, which costs but is safe
@@ -553,8 +553,8 @@ def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj:
         yield Segment(grippers=near, gripper_steps=style.gripper_steps, label="preclose")
         # a jaw on a hinge under a contact-force limit creeps onto the object; without
         # one, its squeeze at SLOW_CLOSE holds better than the guard's own force would
-        hands = ("gripper", *[f"{arm}_gripper" for arm in world.arm_names])
-        if all(world.fingers_slide(arm) for arm in widths) or world.force_limit(obj, *hands) is None:
+        if all(world.fingers_slide(arm) for arm in widths) \
+                or world.force_limit(obj, *world.gripper_entities) is None:
             steps = max([2 * style.gripper_steps] + [
                 int(np.ceil((near[arm] - target[arm]) / SLOW_CLOSE)) for arm in widths])
             yield Segment(grippers=target, gripper_steps=steps, settle=style.settle,

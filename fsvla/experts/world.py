@@ -369,6 +369,12 @@ class World:
             near = self.current_pose(arm).R
         return min(options, key=lambda R: rotation_angle(R, near))
 
+    @property
+    def gripper_entities(self) -> tuple[str, ...]:
+        """The names a scenario may give the hands in a limit: ``gripper``, and each arm's
+        ``<arm>_gripper`` (a two-arm robot's)."""
+        return ("gripper", *[f"{arm}_gripper" for arm in self.arm_names])
+
     def hand_links(self, arm: str) -> tuple[str, ...]:
         """The robot links of ``arm``'s hand and fingers (the monitor's gripper entity)."""
         name = "gripper" if len(self.arm_names) == 1 else f"{arm}_gripper"

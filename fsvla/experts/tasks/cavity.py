@@ -244,7 +244,7 @@ def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
     near = min(again, key=lambda option: float(np.linalg.norm(option[1].p[:2] - goal.p[:2])))
     goal = attained(world, arm, Pose(np.array([goal.p[0], goal.p[1], max(goal.p[2], near[1].p[2])]),
                                      goal.R))
-    limit = world.force_limit("gripper", obj, *[f"{a}_gripper" for a in world.arm_names])
+    limit = world.force_limit(obj, *world.gripper_entities)
     touch = TOUCH_FORCE if limit is None else min(TOUCH_FORCE, 0.25 * limit)
     guard = Guard(arm, touch, target)
     yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, guards=(guard,),

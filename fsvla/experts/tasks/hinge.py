@@ -491,7 +491,7 @@ def pinch_force(world: World, style: Style, body: str) -> float:
     """The careful squeeze on a part of ``body``: the style's grip force, at most half of a
     contact-force limit on the hand or the body and out of its warning band, at least 2 N."""
     force = float(style.grip_force or 0.0)
-    allowed = world.force_allowance("gripper", body, *[f"{a}_gripper" for a in world.arm_names])
+    allowed = world.force_allowance(body, *world.gripper_entities)
     return max(force if allowed is None else min(force, allowed), 2.0)
 
 
