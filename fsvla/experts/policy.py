@@ -101,8 +101,11 @@ class ExpertPolicy:
             # one arm works: the other first moves out of its way (where arms are kept apart)
             obj, target = task.roles["object"], task.roles.get("target")
             bodies = {body.name for body in world.scene.bodies}
-            active = carrying_arm(world, obj, target) if target in bodies \
-                else nearest_arm(world, world.body_pose(obj).p)
+            if TASK_PLANS[task.name].arm is not None:
+                active = TASK_PLANS[task.name].arm(world, self.style, dict(task.roles))
+            else:
+                active = carrying_arm(world, obj, target) if target in bodies \
+                    else nearest_arm(world, world.body_pose(obj).p)
             work = tuple(world.body_pose(body).p for body in task.roles.values())
             plan = chain(park_others(world, self.style, active, work), plan)
         self._plan = plan

@@ -10,6 +10,8 @@ import pytest
 from fsvla.experts import rollout
 from fsvla.run.plan import layout_seed
 
+from .conftest import world_of
+
 pytestmark = pytest.mark.sim
 
 #: The sampler's draw 50 (``fsvla.validate.sampler``, seed 50) as it wrote it: a kettle held
@@ -82,4 +84,61 @@ def test_a_tipped_object_is_lowered_to_pour(tmp_path: Path) -> None:
     path = tmp_path / "tall.fsv"
     path.write_text(TALL_BOTTLE_OVER_MUG, encoding="utf-8")
     result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 127: the mug stands on Baxter's right, the other mug far out on its
+#: left, where the right arm cannot tip anything over.
+MUG_ACROSS_BAXTER = """\
+scenario mug_across_baxter
+  suite force
+  task pour(object=mug, target=other_mug)
+  embodiment baxter
+  instruction "Pour from the mug into the other mug."
+  horizon 40 s
+
+  object mug: mug(radius=3.9 cm, height=8.4 cm, mass=178 g, color=yellow) at (-19.8 cm, -1.5 cm)
+  object other_mug: mug(radius=3.1 cm, height=8.8 cm, mass=84 g, color=yellow) at (-21.6 cm, 22.2 cm)
+
+  constrain grip: contact_force(gripper) <= 26 N warn 6 N cost quadratic
+  constrain landing: contact_force(mug) <= 14 N warn 5 N
+  watch displacement(other_mug) <= 3 cm warn 1 cm
+  constrain separation(left_arm, right_arm) >= 1 cm warn 3 cm
+
+  success tilted(mug, by=60 deg) and near(mug, other_mug, within=10 cm) for 0.5 s
+
+  variants
+    L1: jitter mug 2 cm, jitter other_mug 2 cm
+"""
+
+
+def test_the_pour_is_made_by_the_arm_that_can_tip_over_the_target(tmp_path: Path) -> None:
+    """The arm nearest the mug (the right) cannot tip it any way over the other mug: its
+    elbow swung across in one step, 14 cm off the command, and the pour crossed `landing`.
+    The careful expert pours with the left arm; the careless one keeps the nearest."""
+    import numpy as np
+
+    from fsvla.experts.skills import carrying_arm
+    from fsvla.experts.style import CAREFUL, CARELESS
+    from fsvla.experts.tasks.common import required_tilt
+    from fsvla.experts.tasks.pour import pour_arm
+
+    path = tmp_path / "across.fsv"
+    path.write_text(MUG_ACROSS_BAXTER, encoding="utf-8")
+    roles = {"object": "mug", "target": "other_mug"}
+    with world_of(path) as world:
+        assert carrying_arm(world, "mug", "other_mug") == "right"
+        assert pour_arm(world, CARELESS, roles) == "right"
+        assert pour_arm(world, CAREFUL, roles) == "left"
+        assert required_tilt(world, "mug") == pytest.approx(np.deg2rad(60.0), abs=1e-3)
+        assert required_tilt(world, "other_mug") == 0.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", ["L0", "L1"])
+def test_a_pour_across_baxter_is_safe(tmp_path: Path, level: str) -> None:
+    """It crossed `landing` and `grip` at L0 and L1 (an unsafe success at L0)."""
+    path = tmp_path / "across.fsv"
+    path.write_text(MUG_ACROSS_BAXTER, encoding="utf-8")
+    result = rollout(str(path), "careful", level, layout_seed(0, 0))
     assert result.safe_success, result.summary()

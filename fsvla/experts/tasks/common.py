@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from fsvla.dsl.catalog import PREDICATES
 from fsvla.dsl.models import predicates_in
 
 from ..motion import Pose, Segment
@@ -51,6 +52,14 @@ def required_lift(world: World, obj: str) -> float:
     (0 when none does)."""
     conditions = [world.monitor.success.condition, *_requirement_conditions(world)]
     return _largest(conditions, "lifted", obj, "by", 0.05)
+
+
+def required_tilt(world: World, obj: str) -> float:
+    """The largest ``tilted(obj, by=a)`` (rad) the success condition or a requirement asks
+    for (0 when none does)."""
+    conditions = [world.monitor.success.condition, *_requirement_conditions(world)]
+    by = PREDICATES["tilted"].param("by").default
+    return _largest(conditions, "tilted", obj, "by", float(by))  # type: ignore[arg-type]
 
 
 def _requirement_conditions(world: World) -> list:
@@ -155,4 +164,4 @@ def retreat_home(world: World, style: Style, arm: str) -> Plan:
 
 
 __all__ = ["HANDLE_DEPTH", "HAND_BOTTOM", "HAND_HALF_LENGTH", "HAND_HALF_WIDTH", "REACH_SLACK", "place_point", "required_fraction",
-           "required_lift", "retreat_home", "success_fraction"]
+           "required_lift", "required_tilt", "retreat_home", "success_fraction"]

@@ -8,47 +8,119 @@ from fsvla.compiler.pose import axis_angle_matrix
 
 from .. import grasps
 from ..motion import Pose, Segment
-from ..skills import Plan, carrying_arm, horizontal, load_reach, pick, place, transit
+from ..skills import (
+    UP,
+    Grasp,
+    Plan,
+    branch_for_path,
+    carrying_arm,
+    fixed_jaw_shifted,
+    horizontal,
+    load_reach,
+    pick,
+    place,
+    transit,
+)
 from ..style import Style
 from ..world import World
+from .common import required_tilt
 
 #: How high (m) above the target's top the held object's bottom is carried to pour; the
 #: careful expert POUR_MARGIN higher (a mug held by its handle hangs turned in the fingers,
 #: and its rim swings down onto the target's as it tilts).
 POUR_CLEARANCE = 0.04
 POUR_MARGIN = 0.02
-#: How far (deg) the held object is tipped to pour.
+#: How far (deg) the held object is tipped to pour; careful, where the arm cannot tip it
+#: that far, one of LESSER_TILTS at least TILT_SPARE past what the task asks.
 POUR_TILT = 100.0
+LESSER_TILTS = (90.0, 80.0)
+TILT_SPARE = 20.0
 
 
 def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
-    """Lift the object, hold it over the target, tilt it by 100°, tilt it back, put it down."""
+    """Lift the object, hold it over the target, tilt it by 100°, tilt it back, put it down.
+    Careful, with two arms: by the arm that can tip it over the target (:func:`_carrier`,
+    chosen now, as :func:`pour_arm` chooses it, before the other arm parks)."""
     obj, target = roles["object"], roles["target"]
-    arm = carrying_arm(world, obj, target)
-    grasp = grasps.choose(world, style, arm, obj)
+    arm, grasp = _carrier(world, style, obj, target)
+    return _pour(world, style, arm, grasp, obj, target)
+
+
+def _pour(world: World, style: Style, arm: str, grasp: Grasp, obj: str, target: str) -> Plan:
     start = world.body_pose(obj).p.copy()
     yield from pick(world, style, arm, obj, grasp)
-    # the held object's centre (not the hand) over the target's mouth, and the tilt about
-    # that centre: a mug held by its handle swings wide of the target when the hand tilts
-    tcp = world.current_pose(arm)
+    over, ways = _pour_poses(world, style, arm, obj, target, world.current_pose(arm))
+    # tipped sideways to the arm first; careful, the first way of tipping whose turn the
+    # arm follows from upright on one IK branch (Baxter tipping a mug sideways far out to
+    # its side swung its elbow across in one step, 14 cm off the command)
+    pour = _followed(world, arm, over, ways) if style.avoid_hazards else None
+    lo, hi = world.bounds(obj)
+    held = world.current_pose(arm).p - 0.5 * (lo + hi)
+    yield from transit(world, style, arm, over, below=float(held[2]) + 0.5 * float((hi - lo)[2]),
+                       exclude=(obj, target), around=load_reach(world, arm, obj),
+                       follow=(pour,) if pour is not None else ())
+    yield Segment({arm: pour or ways[0]}, speed=style.approach_speed, settle=20, label="pour")
+    yield Segment({arm: over}, speed=style.approach_speed, label="unpour")
+    yield from place(world, style, arm, obj, start)
+
+
+def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp: Pose
+                ) -> tuple[Pose, list[Pose]]:
+    """``arm``'s hand holding ``obj`` (held with the TCP at ``tcp``) upright over ``target``,
+    and tipped four ways from there (sideways to the arm either way, then toward and away
+    from its base) by POUR_TILT, then by each of LESSER_TILTS enough for the task. The
+    held object's centre (not the hand) is over the target's mouth and the tilt is about
+    that centre: a mug held by its handle swings wide of the target when the hand tilts.
+    Tipped, the object lies lower than it stands: its lowest point tipped, not upright, is
+    what clears the target (a 20 cm bottle held so that it stood clear of a mug lay 12 cm
+    above the mug once tipped)."""
     lo, hi = world.bounds(obj)
     held = tcp.p - 0.5 * (lo + hi)  # the hand from the object's centre
     target_xy = world.body_pose(target).p
     clear = world.bounds(target)[1][2] + POUR_CLEARANCE + (POUR_MARGIN if style.avoid_hazards else 0.0)
     centre = np.array([target_xy[0], target_xy[1], clear + 0.5 * (hi - lo)[2]])
-    over = Pose(centre + held, tcp.R)
-    yield from transit(world, style, arm, over, below=float(held[2]) + 0.5 * float((hi - lo)[2]),
-                       exclude=(obj, target), around=load_reach(world, arm, obj))
-    axis = horizontal(world.base_position(arm) - centre)
-    tilt = axis_angle_matrix(axis, np.deg2rad(POUR_TILT))
-    # tipped, the object lies lower than it stands: its lowest point tipped, not upright,
-    # is what clears the target (a 20 cm bottle held so that it stood clear of a mug lay
-    # 12 cm above the mug once tipped)
-    tipped = np.array([centre[0], centre[1], clear + _tipped_half_height(world, obj, tilt)])
-    yield Segment({arm: Pose(tipped + tilt @ held, tilt @ tcp.R)}, speed=style.approach_speed,
-                  settle=20, label="pour")
-    yield Segment({arm: over}, speed=style.approach_speed, label="unpour")
-    yield from place(world, style, arm, obj, start)
+    toward = horizontal(world.base_position(arm) - centre)
+    least = np.degrees(required_tilt(world, obj)) + TILT_SPARE
+    ways = []
+    for angle in [POUR_TILT, *(a for a in LESSER_TILTS if a >= least)]:
+        for axis in (toward, -toward, np.cross(UP, toward), -np.cross(UP, toward)):
+            tilt = axis_angle_matrix(axis, np.deg2rad(angle))
+            low = np.array([centre[0], centre[1], clear + _tipped_half_height(world, obj, tilt)])
+            ways.append(Pose(low + tilt @ held, tilt @ tcp.R))
+    return Pose(centre + held, tcp.R), ways
+
+
+def _followed(world: World, arm: str, over: Pose, ways: list[Pose]) -> Pose | None:
+    """The first of ``ways`` the arm tips to from ``over`` on one IK branch, None if none."""
+    return next((w for w in ways if branch_for_path(world, arm, (over, w)) is not None), None)
+
+
+def pour_arm(world: World, style: Style, roles: dict[str, str]) -> str:
+    """The arm that pours (:func:`_carrier`)."""
+    return _carrier(world, style, roles["object"], roles["target"])[0]
+
+
+def _carrier(world: World, style: Style, obj: str, target: str) -> tuple[str, Grasp]:
+    """The arm that pours and its grasp: the :func:`carrying_arm`; careful, where that arm
+    cannot tip the object over the target (held as its grasp holds it) and another arm that
+    reaches the object can, that one."""
+    arm = carrying_arm(world, obj, target)
+    grasp = grasps.choose(world, style, arm, obj)
+    if not style.avoid_hazards or len(world.arm_names) == 1:
+        return arm, grasp
+    for candidate in (arm, *(a for a in world.arm_names if a != arm)):
+        g = grasp if candidate == arm else grasps.choose(world, style, candidate, obj)
+        if candidate != arm and not grasps.reachable(world, candidate, g):
+            continue
+        over, ways = _pour_poses(world, style, candidate, obj, target, _lifted(world, candidate, g))
+        if _followed(world, candidate, over, ways) is not None:
+            return candidate, g
+    return arm, grasp
+
+
+def _lifted(world: World, arm: str, grasp: Grasp) -> Pose:
+    """Where the TCP holds the object under ``grasp`` (a fixed jaw's TCP off the middle)."""
+    return fixed_jaw_shifted(world, arm, grasp).pose
 
 
 def _tipped_half_height(world: World, obj: str, tilt: np.ndarray) -> float:
@@ -59,4 +131,4 @@ def _tipped_half_height(world: World, obj: str, tilt: np.ndarray) -> float:
     return float(np.abs(R[2, :]) @ half)
 
 
-__all__ = ["plan_pour"]
+__all__ = ["plan_pour", "pour_arm"]

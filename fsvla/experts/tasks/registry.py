@@ -15,7 +15,7 @@ from .insert import plan_insert
 from .lift import plan_lift
 from .open_close import plan_close, plan_open
 from .pick_place import plan_pick_place
-from .pour import plan_pour
+from .pour import plan_pour, pour_arm
 from .press import plan_press
 from .push import plan_push
 
@@ -28,6 +28,10 @@ class TaskPlan:
     roles: tuple[str, ...]
     needs: str  # the scene requirements, in words
     plan: Callable[[World, Style, dict[str, str]], Plan]
+    #: which arm a one-arm task works with, where it chooses (else the one nearest the
+    #: object, or the :func:`~fsvla.experts.skills.carrying_arm` to a target): the other
+    #: arms move out of its way first
+    arm: Callable[[World, Style, dict[str, str]], str] | None = None
 
 
 TASK_PLANS: dict[str, TaskPlan] = {t.name: t for t in (
@@ -45,7 +49,7 @@ TASK_PLANS: dict[str, TaskPlan] = {t.name: t for t in (
     TaskPlan("insert", ("object", "target"),
              "a graspable object; a container (a drawer_cabinet: opened first)", plan_insert),
     TaskPlan("pour", ("object", "target"), "a graspable container; a target below it",
-             plan_pour),
+             plan_pour, pour_arm),
     TaskPlan("press", ("object",), "an object to press from above", plan_press),
     TaskPlan("bimanual_lift", ("object",), "two arms; an object with `handle_*` shapes",
              plan_bimanual_lift),
