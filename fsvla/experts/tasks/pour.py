@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from fsvla.compiler.pose import axis_angle_matrix
+from fsvla.compiler.pose import axis_angle_matrix, slerp
 
 from .. import grasps
-from ..motion import Pose, Segment
+from ..motion import ArmDriver, Pose, Segment
 from ..skills import (
     UP,
     Grasp,
@@ -22,8 +22,8 @@ from ..skills import (
     transit,
 )
 from ..style import Style
-from ..world import World
-from .common import required_tilt
+from ..world import World, box_distance
+from .common import HAND_HALF_LENGTH, required_tilt
 
 #: How high (m) above the target's top the held object's bottom is carried to pour; the
 #: careful expert POUR_MARGIN higher (a mug held by its handle hangs turned in the fingers,
@@ -35,25 +35,27 @@ POUR_MARGIN = 0.02
 POUR_TILT = 100.0
 LESSER_TILTS = (90.0, 80.0)
 TILT_SPARE = 20.0
+#: A held object's centre and upright axis in the hand's frame.
+Load = tuple[np.ndarray, np.ndarray]
 
 
 def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
     """Lift the object, hold it over the target, tilt it by 100°, tilt it back, put it down.
     Careful, with two arms: by the arm that can tip it over the target (:func:`_carrier`,
-    chosen now, as :func:`pour_arm` chooses it, before the other arm parks)."""
+    as :func:`pour_arm` chooses it)."""
     obj, target = roles["object"], roles["target"]
     arm, grasp = _carrier(world, style, obj, target)
-    return _pour(world, style, arm, grasp, obj, target)
-
-
-def _pour(world: World, style: Style, arm: str, grasp: Grasp, obj: str, target: str) -> Plan:
     start = world.body_pose(obj).p.copy()
     yield from pick(world, style, arm, obj, grasp)
-    over, ways = _pour_poses(world, style, arm, obj, target, world.current_pose(arm))
-    # tipped sideways to the arm first; careful, the first way of tipping whose turn the
-    # arm follows from upright on one IK branch (Baxter tipping a mug sideways far out to
-    # its side swung its elbow across in one step, 14 cm off the command)
-    pour = _followed(world, arm, over, ways) if style.avoid_hazards else None
+    over, ways, load = _pour_poses(world, style, arm, obj, target, world.current_pose(arm))
+    # tipped sideways to the arm; careful, where the arm does not reach it tipped so,
+    # the first other way of tipping whose turn it follows from upright on one IK branch
+    # (Baxter tipping a mug sideways far out to its side swung its elbow across in one
+    # step, 14 cm off the command)
+    pour = None
+    if style.avoid_hazards and not _reaches(world, arm, ways[0]):
+        # the first way ends beyond the arm's reach: another one it follows
+        pour = _followed(world, arm, obj, target, over, ways, load)
     lo, hi = world.bounds(obj)
     held = world.current_pose(arm).p - 0.5 * (lo + hi)
     yield from transit(world, style, arm, over, below=float(held[2]) + 0.5 * float((hi - lo)[2]),
@@ -65,7 +67,7 @@ def _pour(world: World, style: Style, arm: str, grasp: Grasp, obj: str, target: 
 
 
 def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp: Pose
-                ) -> tuple[Pose, list[Pose]]:
+                ) -> tuple[Pose, list[Pose], Load]:
     """``arm``'s hand holding ``obj`` (held with the TCP at ``tcp``) upright over ``target``,
     and tipped four ways from there (sideways to the arm either way, then toward and away
     from its base) by POUR_TILT, then by each of LESSER_TILTS enough for the task. The
@@ -73,7 +75,8 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
     that centre: a mug held by its handle swings wide of the target when the hand tilts.
     Tipped, the object lies lower than it stands: its lowest point tipped, not upright, is
     what clears the target (a 20 cm bottle held so that it stood clear of a mug lay 12 cm
-    above the mug once tipped)."""
+    above the mug once tipped). Last, the object's centre and upright axis in the hand's
+    frame."""
     lo, hi = world.bounds(obj)
     held = tcp.p - 0.5 * (lo + hi)  # the hand from the object's centre
     target_xy = world.body_pose(target).p
@@ -87,12 +90,50 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
             tilt = axis_angle_matrix(axis, np.deg2rad(angle))
             low = np.array([centre[0], centre[1], clear + _tipped_half_height(world, obj, tilt)])
             ways.append(Pose(low + tilt @ held, tilt @ tcp.R))
-    return Pose(centre + held, tcp.R), ways
+    load = (-tcp.R.T @ held, tcp.R.T @ world.body_pose(obj).R[:, 2])
+    return Pose(centre + held, tcp.R), ways, load
 
 
-def _followed(world: World, arm: str, over: Pose, ways: list[Pose]) -> Pose | None:
-    """The first of ``ways`` the arm tips to from ``over`` on one IK branch, None if none."""
-    return next((w for w in ways if branch_for_path(world, arm, (over, w)) is not None), None)
+def _reaches(world: World, arm: str, pose: Pose) -> bool:
+    """Whether IK puts the arm's TCP at ``pose`` (from any start, within the limits)."""
+    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                       world.arm_joints(arm), 1.0)
+    driver.solve_anywhere(pose)
+    return not driver.ik_misses
+
+
+def _followed(world: World, arm: str, obj: str, target: str, over: Pose, ways: list[Pose],
+              load: Load) -> Pose | None:
+    """The first of ``ways`` the arm tips to from ``over`` on one IK branch with the hand
+    and the held object clear of the hazards all the way (:func:`_clear`), None if none."""
+    return next((w for w in ways if _clear(world, arm, obj, target, over, w, load)
+                 and branch_for_path(world, arm, (over, w)) is not None), None)
+
+
+def _clear(world: World, arm: str, obj: str, target: str, over: Pose, way: Pose,
+           load: Load) -> bool:
+    """Whether the hand (its TCP, and its body 6 cm back and that body's two ends along the
+    finger axis), the held object's centre (less its half width) and the two ends of its
+    upright axis stay out of every obstacle's keep-out as the hand turns from ``over`` to
+    ``way`` (another way of tipping a mug beside a hot kettle swung the hand into the
+    kettle's keep-out)."""
+    obstacles = world.obstacles(exclude=(obj, target))
+    if not obstacles:
+        return True
+    half = np.asarray(world.asset(obj).bounds.half_extents, dtype=np.float64)
+    centre, up = load
+    for s in (0.25, 0.5, 0.75, 1.0):
+        R = slerp(over.R, way.R, s)
+        p = over.p + s * (way.p - over.p)
+        c = p + R @ centre
+        body = p - 0.06 * (R @ world.approach_axis(arm))
+        across = HAND_HALF_LENGTH * (R @ world.finger_axis(arm))
+        for point, size in ((p, 0.0), (body + across, 0.0), (body - across, 0.0),
+                            (c, float(max(half[0], half[1]))),
+                            (c + R @ up * half[2], 0.0), (c - R @ up * half[2], 0.0)):
+            if min(box_distance(point, o.lo, o.hi) - o.margin for o in obstacles) < size:
+                return False
+    return True
 
 
 def pour_arm(world: World, style: Style, roles: dict[str, str]) -> str:
@@ -112,8 +153,9 @@ def _carrier(world: World, style: Style, obj: str, target: str) -> tuple[str, Gr
         g = grasp if candidate == arm else grasps.choose(world, style, candidate, obj)
         if candidate != arm and not grasps.reachable(world, candidate, g):
             continue
-        over, ways = _pour_poses(world, style, candidate, obj, target, _lifted(world, candidate, g))
-        if _followed(world, candidate, over, ways) is not None:
+        over, ways, load = _pour_poses(world, style, candidate, obj, target,
+                                       _lifted(world, candidate, g))
+        if _followed(world, candidate, obj, target, over, ways, load) is not None:
             return candidate, g
     return arm, grasp
 
