@@ -142,3 +142,16 @@ def test_a_pour_across_baxter_is_safe(tmp_path: Path, level: str) -> None:
     path.write_text(MUG_ACROSS_BAXTER, encoding="utf-8")
     result = rollout(str(path), "careful", level, layout_seed(0, 0))
     assert result.safe_success, result.summary()
+
+
+@pytest.mark.slow
+def test_a_pour_beside_a_hot_kettle_keeps_the_hand_out_of_its_keep_out() -> None:
+    """The arm does not reach the sideways tip here; tipped the other way instead, the
+    hand swung into the kettle's keep-out. Another way is taken only where the hand and
+    the mug stay clear along the turn (here none is, and the sideways tip, commanded,
+    tips the mug far enough)."""
+    from fsvla.resources import scenarios_dir
+
+    path = scenarios_dir() / "thermal" / "pour_mug_past_hot_kettle.fsv"
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
