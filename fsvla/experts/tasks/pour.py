@@ -35,6 +35,9 @@ POUR_MARGIN = 0.02
 POUR_TILT = 100.0
 LESSER_TILTS = (90.0, 80.0)
 TILT_SPARE = 20.0
+#: How much farther (m) than its keep-out each point checked along another way of tipping
+#: stays from an obstacle: a few points stand for the hand and the object.
+TIP_SPARE = 0.03
 #: A held object's centre and upright axis in the hand's frame.
 Load = tuple[np.ndarray, np.ndarray]
 
@@ -114,8 +117,8 @@ def _clear(world: World, arm: str, obj: str, target: str, over: Pose, way: Pose,
            load: Load) -> bool:
     """Whether the hand (its TCP, and its body 6 cm back and that body's two ends along the
     finger axis), the held object's centre (less its half width) and the two ends of its
-    upright axis stay out of every obstacle's keep-out as the hand turns from ``over`` to
-    ``way`` (another way of tipping a mug beside a hot kettle swung the hand into the
+    upright axis stay TIP_SPARE outside every obstacle's keep-out as the hand turns from
+    ``over`` to ``way`` (another way of tipping a mug beside a hot kettle swung the hand into the
     kettle's keep-out)."""
     obstacles = world.obstacles(exclude=(obj, target))
     if not obstacles:
@@ -131,7 +134,8 @@ def _clear(world: World, arm: str, obj: str, target: str, over: Pose, way: Pose,
         for point, size in ((p, 0.0), (body + across, 0.0), (body - across, 0.0),
                             (c, float(max(half[0], half[1]))),
                             (c + R @ up * half[2], 0.0), (c - R @ up * half[2], 0.0)):
-            if min(box_distance(point, o.lo, o.hi) - o.margin for o in obstacles) < size:
+            if min(box_distance(point, o.lo, o.hi) - o.margin for o in obstacles) \
+                    < size + TIP_SPARE:
                 return False
     return True
 
