@@ -96,16 +96,20 @@ class ExpertPolicy:
             if self.style.avoid_hazards:  # its links too, not only the hand, kept clear
                 clearance = ArmClearance(world, name)
                 self._drivers[name].clearance = clearance if clearance.active else None
-        plan = TASK_PLANS[task.name].plan(world, self.style, dict(task.roles))
-        if task.name not in BIMANUAL_TASKS and len(world.arm_names) > 1:
+        task_plan, roles = TASK_PLANS[task.name], dict(task.roles)
+        if task.name in BIMANUAL_TASKS or len(world.arm_names) == 1:
+            plan = task_plan.plan(world, self.style, roles)
+        else:
             # one arm works: the other first moves out of its way (where arms are kept apart)
             obj, target = task.roles["object"], task.roles.get("target")
             bodies = {body.name for body in world.scene.bodies}
-            if TASK_PLANS[task.name].arm is not None:
-                active = TASK_PLANS[task.name].arm(world, self.style, dict(task.roles))
+            if task_plan.arm is not None:  # the task chooses its arm: chosen once, here
+                active = task_plan.arm(world, self.style, roles)
+                plan = task_plan.plan(world, self.style, roles, arm=active)
             else:
                 active = carrying_arm(world, obj, target) if target in bodies \
                     else nearest_arm(world, world.body_pose(obj).p)
+                plan = task_plan.plan(world, self.style, roles)
             work = tuple(world.body_pose(body).p for body in task.roles.values())
             plan = chain(park_others(world, self.style, active, work), plan)
         self._plan = plan

@@ -42,12 +42,15 @@ TIP_SPARE = 0.03
 Load = tuple[np.ndarray, np.ndarray]
 
 
-def plan_pour(world: World, style: Style, roles: dict[str, str]) -> Plan:
+def plan_pour(world: World, style: Style, roles: dict[str, str], arm: str | None = None) -> Plan:
     """Lift the object, hold it over the target, tilt it by 100°, tilt it back, put it down.
-    Careful, with two arms: by the arm that can tip it over the target (:func:`_carrier`,
-    as :func:`pour_arm` chooses it)."""
+    By ``arm`` where the caller has chosen it with :func:`pour_arm` (the policy does);
+    else by the arm :func:`_carrier` chooses."""
     obj, target = roles["object"], roles["target"]
-    arm, grasp = _carrier(world, style, obj, target)
+    if arm is None:
+        arm, grasp = _carrier(world, style, obj, target)
+    else:
+        grasp = grasps.choose(world, style, arm, obj)
     start = world.body_pose(obj).p.copy()
     yield from pick(world, style, arm, obj, grasp)
     over, ways, load = _pour_poses(world, style, arm, obj, target, world.current_pose(arm))

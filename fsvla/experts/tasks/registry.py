@@ -27,10 +27,10 @@ class TaskPlan:
     name: str
     roles: tuple[str, ...]
     needs: str  # the scene requirements, in words
-    plan: Callable[[World, Style, dict[str, str]], Plan]
+    plan: Callable[..., Plan]  # (world, style, roles); with ``arm``, also ``arm=``
     #: which arm a one-arm task works with, where it chooses (else the one nearest the
     #: object, or the :func:`~fsvla.experts.skills.carrying_arm` to a target): the other
-    #: arms move out of its way first
+    #: arms move out of its way first, and ``plan`` is given that arm as ``arm=``
     arm: Callable[[World, Style, dict[str, str]], str] | None = None
 
 
