@@ -30,6 +30,7 @@ from .urdf import parse_urdf
 
 TEMPLATE_DIR = Path(__file__).parent / "templates"
 OPEN_LIMIT = math.radians(110.0)  # how far a door or lid swings open
+DOOR_GAP = 0.003  # m between a hinged door's bottom edge and the table
 DRAWER_CLEARANCE = 0.002  # gap between a drawer and its carcass
 
 METAL_GREY = PLASTIC.appearance(color=(0.72, 0.73, 0.75, 1.0)).base_color
@@ -248,11 +249,13 @@ def build_microwave(params: Mapping[str, ParamValue]) -> ArticulatedAsset:
     body = box_link("body", panels, PLASTIC)
     door_w = w - control
     # door frame: on the hinge, the left (+y) edge of the front (-x) face; the closed
-    # door runs from there towards -y
+    # door runs from there towards -y, its bottom edge DOOR_GAP above what the body
+    # stands on (a door down to the table dragged its weight across it as it swung)
     door = box_link(
         "door",
         [
-            Panel("panel", (t, door_w, h), (-t / 2.0, -door_w / 2.0, h / 2.0), DARK_GLASS),
+            Panel("panel", (t, door_w, h - DOOR_GAP),
+                  (-t / 2.0, -door_w / 2.0, (h + DOOR_GAP) / 2.0), DARK_GLASS),
             Panel("handle", (0.02, 0.015, 0.5 * h), (-t - 0.01, -(door_w - 0.03), h / 2.0), HANDLE),
         ],
         PLASTIC,
