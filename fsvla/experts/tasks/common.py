@@ -36,6 +36,17 @@ HAND_BOTTOM = 0.037
 HANDLE_DEPTH = 0.02
 
 
+#: The force (N) a careful push stops at where no contact-force limit watches it.
+PUSH_FORCE = 25.0
+
+
+def push_force(world: World, arm: str, body: str) -> float:
+    """What a careful push of ``body`` stops at: PUSH_FORCE, or half of the tightest
+    contact-force limit on the hand or the body and out of its warning band, at least 3 N."""
+    allowed = world.force_allowance("gripper", f"{arm}_gripper", body)
+    return max(3.0, PUSH_FORCE if allowed is None else min(PUSH_FORCE, allowed))
+
+
 def required_fraction(world: World, body: str) -> float:
     """The largest ``opened(body, fraction=f)`` any requirement asks for (0 when none does)."""
     return _largest(_requirement_conditions(world), "opened", body, "fraction", 0.5)

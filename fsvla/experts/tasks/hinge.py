@@ -289,7 +289,8 @@ def _turning_grip(world: World, arm: str, now: float, angle: float,
 
 
 def swing_lid(world: World, style: Style, body: str, angle: float,
-              least: float | None = None, missed: Callable[[], Plan] | None = None) -> Plan:
+              least: float | None = None, missed: Callable[[], Plan] | None = None,
+              unreachable: Callable[[], Plan] | None = None) -> Plan:
     """Pinch a lid's knob by its ends (the fingers closing along the hinge) and carry it
     along its arc to ``angle`` (rad), the hand turning with the lid; let go and rise.
     The hand's turn on the lid is the one that keeps it nearest pointing down over the
@@ -300,7 +301,8 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     but at least to ``least`` (rad), and held there, since it would fall shut. Where no
     fixed turn on the lid is followed even that far, the hand turns on the knob along the
     arc (:func:`_turning_grip`). A careful pinch that feels nothing from the knob (fingers
-    thicker than it stands out) lets go and runs ``missed`` instead, or says so."""
+    thicker than it stands out) lets go and runs ``missed`` instead, or says so; one that
+    finds no grip IK follows runs ``unreachable`` instead, or says so."""
     now = hinge(world, body).now
     grip, held = None, False
     for turning in (False, True):  # a grip that turns on the knob only where no fixed one holds
@@ -313,6 +315,9 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
                     break
         if grip is not None:
             break
+    if grip is None and unreachable is not None:
+        yield from unreachable()
+        return
     if grip is None:
         raise NotImplementedError(_out_of_reach(nearest_arm(world, world.body_pose(body).p),
                                                 body, "knob", now, angle))
@@ -348,10 +353,12 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
 LID_RESTS = (85.0, 80.0, 75.0, 70.0)
 
 
-def lower_lid(world: World, style: Style, body: str, angle: float) -> Plan:
+def lower_lid(world: World, style: Style, body: str, angle: float,
+              instead: Callable[[], Plan] | None = None) -> Plan:
     """Bring a lid down to ``angle`` (rad) by its knob (:func:`swing_lid`); careful, where
     no one grip follows the whole arc, in two: down to where the lid rests on its own
-    (LID_RESTS), let go, and again from there with the grip that follows the rest."""
+    (LID_RESTS), let go, and again from there with the grip that follows the rest; where
+    no grip is followed at all, or the pinch feels nothing, ``instead`` (or say so)."""
     h = hinge(world, body)
     if style.avoid_hazards and _lid_grip(world, style, body, h.now, angle) is None:
         for rest in np.deg2rad(LID_RESTS):
@@ -361,7 +368,7 @@ def lower_lid(world: World, style: Style, body: str, angle: float) -> Plan:
                 yield from swing_lid(world, style, body, float(rest))
                 yield from swing_lid(world, style, body, angle)
                 return
-    yield from swing_lid(world, style, body, angle)
+    yield from swing_lid(world, style, body, angle, missed=instead, unreachable=instead)
 
 
 def _rests(world: World, body: str, theta: float) -> bool:

@@ -9,7 +9,7 @@ import numpy as np
 
 from fsvla.compiler.pose import axis_angle_matrix
 
-from ..motion import Pose, Segment
+from ..motion import Guard, Pose, Segment
 from ..skills import UP, Plan, branch_for_path, free_speed, nearest_arm, transit
 from ..style import Style
 from ..world import World
@@ -100,10 +100,12 @@ def _chained(pose_at: Callable[..., Pose], start: float, end: float, near: np.nd
 
 
 def smooth_arc(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose],
-                start: float, end: float, speed: float, label: str) -> Plan:
+               start: float, end: float, speed: float, label: str,
+               guards: tuple[Guard, ...] = ()) -> Plan:
     """Follow ``pose_at(theta)`` from ``start`` to ``end`` without stopping: one segment per
     control step, the parameter eased in and out over the whole arc, the peak TCP speed
-    ``speed`` and the peak turn rate within the style's angular speed."""
+    ``speed`` and the peak turn rate within the style's angular speed; each segment
+    ``guards``ed."""
     thetas = np.linspace(start, end, 50)
     points = np.array([pose_at(float(t)).p for t in thetas])
     length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
@@ -112,7 +114,8 @@ def smooth_arc(world: World, style: Style, arm: str, pose_at: Callable[[float], 
     for i in range(1, n + 1):
         s = i / n
         theta = start + (end - start) * s * s * (3.0 - 2.0 * s)
-        yield Segment({arm: pose_at(float(theta))}, speed=2.0 * speed, label=label)
+        yield Segment({arm: pose_at(float(theta))}, speed=2.0 * speed, label=label,
+                      guards=guards)
 
 
 __all__ = ["LID_PAST_VERTICAL", "lift_lid", "smooth_arc"]

@@ -20,7 +20,13 @@ from ..skills import (
 )
 from ..style import Style
 from ..world import World
-from .common import HAND_HALF_WIDTH, HANDLE_DEPTH, required_fraction, success_fraction
+from .common import (
+    HAND_HALF_WIDTH,
+    HANDLE_DEPTH,
+    push_force,
+    required_fraction,
+    success_fraction,
+)
 from .hinge import (
     has_shape,
     knob_pinch_fits,
@@ -31,6 +37,7 @@ from .hinge import (
     swing_lid,
 )
 from .lid import LID_PAST_VERTICAL, lift_lid
+from .push_shut import push_shut
 
 
 def part_handle(world: World, body: str):
@@ -89,17 +96,6 @@ def push_part_closed(world: World, style: Style, body: str) -> Plan:
     yield Segment({arm: back.moved(0.04 * opening)}, speed=free_speed(style), label="back")
     yield Segment({arm: back.moved(0.04 * opening + 0.1 * UP)}, speed=free_speed(style),
                   label="up")
-
-
-#: The force (N) a careful push stops at where no contact-force limit watches it.
-PUSH_FORCE = 25.0
-
-
-def push_force(world: World, arm: str, body: str) -> float:
-    """What a careful push of ``body`` stops at: PUSH_FORCE, or half of the tightest
-    contact-force limit on the hand or the body and out of its warning band, at least 3 N."""
-    allowed = world.force_allowance("gripper", f"{arm}_gripper", body)
-    return max(3.0, PUSH_FORCE if allowed is None else min(PUSH_FORCE, allowed))
 
 
 def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Plan:
@@ -208,9 +204,12 @@ def plan_open(world: World, style: Style, roles: dict[str, str]) -> Plan:
 
 
 def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
-    """A drawer: push its front shut; a part already shut is left alone; a lid standing
-    open: pinch its knob, pull it over upright and lower it onto its seat; a hinged door:
-    pinch its handle and swing it shut."""
+    """A drawer: push its front shut. A part already shut: left alone. A lid standing open:
+    pinch its knob, pull it over upright and lower it onto its seat. A hinged door:
+    careful, push it shut with the closed hand on its face (:mod:`.push_shut`), or where
+    no arm follows that, swing it by its handle; careless, swing it by its handle. Any
+    other hinged panel, and a lid whose knob the hand cannot pinch (wider than it opens,
+    out of reach, or felt nothing): push it shut."""
     body = roles["object"]
     part, joint = world.part(body)
     span = joint.upper - joint.lower
@@ -219,9 +218,17 @@ def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
     elif _sliding(world, body):
         yield from push_part_closed(world, style, body)
     elif _knob_lid(world, body) and knob_pinch_fits(world, body):
-        yield from lower_lid(world, style, body, SWUNG_SHUT * span)
+        yield from lower_lid(world, style, body, SWUNG_SHUT * span,
+                             instead=lambda: push_shut(world, style, body, SWUNG_SHUT * span))
+    elif _handled_door(world, body) and style.avoid_hazards:
+        # pushed shut, holding nothing, where the arm follows the door's face; else by its
+        # handle
+        yield from push_shut(world, style, body, SWUNG_SHUT * span,
+                             unreachable=lambda: swing_door(world, style, body, SWUNG_SHUT * span))
     elif _handled_door(world, body):
         yield from swing_door(world, style, body, SWUNG_SHUT * span)
+    elif _hinged_panel(world, body):
+        yield from push_shut(world, style, body, SWUNG_SHUT * span)
     else:
         raise NotImplementedError(_unsupported(body, part.name, joint.type, "close"))
 
@@ -239,6 +246,12 @@ def _knob_lid(world: World, body: str) -> bool:
             and has_shape(world, body, part.link, "panel"))
 
 
+def _hinged_panel(world: World, body: str) -> bool:
+    """A revolute part with a `panel` (a lid or a door, whatever it is held by)."""
+    part, joint = world.part(body)
+    return joint.type == "revolute" and has_shape(world, body, part.link, "panel")
+
+
 def _handled_door(world: World, body: str) -> bool:
     """A revolute part with a `handle` and a `panel` (a door on a hinge)."""
     part, joint = world.part(body)
@@ -248,7 +261,8 @@ def _handled_door(world: World, body: str) -> bool:
 
 def _unsupported(body: str, part: str, joint: str, verb: str) -> str:
     return (f"the experts cannot yet {verb} `{body}`'s {joint} `{part}`: they open and "
-            f"close drawers and doors by a `handle` and lids by a `knob`")
+            f"close drawers and doors by a `handle` and lids by a `knob`, and push shut "
+            f"any hinged part with a `panel`")
 
 
 __all__ = ["SHUT", "part_handle", "plan_close", "plan_move_part", "plan_open", "push_part_closed"]
