@@ -9,7 +9,16 @@ from collections.abc import Callable
 import numpy as np
 
 from ..motion import Guard, Pose, Segment
-from ..skills import DOWN, UP, Plan, branch_for_path, leaning_frame, nearest_arm, transit
+from ..skills import (
+    DOWN,
+    UP,
+    Plan,
+    attained,
+    branch_for_path,
+    leaning_frame,
+    nearest_arm,
+    transit,
+)
 from ..style import Style
 from ..world import World, box_distance
 from .common import HAND_HALF_LENGTH, retreat_home
@@ -97,8 +106,15 @@ def _press_frame(world: World, style: Style, arm: str, obj: str, top: np.ndarray
     hazards and the other objects beside the button (a hand 21 cm long lying across a
     neighbour comes down on it), among the turns the arm reaches above the top. Where the
     arm holds no hand pointing down there at all, one leaning (:func:`_leaning_frame`)."""
-    default = world.grasp_frame(arm, DOWN, np.array([0.0, 1.0, 0.0]))
     reach = world.hand_reach(arm)
+
+    def held(R: np.ndarray) -> np.ndarray:
+        # turned by a degree or two to what the arm holds on the pressed top (a five-joint
+        # arm's TCP sits off its wrist's roll axis: leaning out, an SO-101 misses the
+        # exact turn by 2-3 mm, and no branch follows it down)
+        return attained(world, arm, Pose(top + reach * UP, R)).R
+
+    default = held(world.grasp_frame(arm, DOWN, np.array([0.0, 1.0, 0.0])))
 
     def followed(R: np.ndarray) -> bool:
         # reached above the top and on the way down to it, on one branch (a five-joint arm
@@ -122,7 +138,7 @@ def _press_frame(world: World, style: Style, arm: str, obj: str, top: np.ndarray
         best: tuple[float, np.ndarray] | None = None
         for yaw in np.deg2rad([90.0, 45.0, 0.0, 135.0]) if boxes else ():  # y first
             closing = np.array([np.cos(yaw), np.sin(yaw), 0.0])
-            R = world.grasp_frame(arm, DOWN, closing)
+            R = held(world.grasp_frame(arm, DOWN, closing))
             if not followed(R):
                 continue
             ends = (level + HAND_HALF_LENGTH * closing, level - HAND_HALF_LENGTH * closing)
@@ -133,19 +149,20 @@ def _press_frame(world: World, style: Style, arm: str, obj: str, top: np.ndarray
         if best is not None:
             return best[1]
     if out_of_reach(default):
-        leaning = _leaning_frame(world, arm, top, followed)
+        leaning = _leaning_frame(world, arm, top, followed, held)
         if leaning is not None:
             return leaning
     return default
 
 
 def _leaning_frame(world: World, arm: str, top: np.ndarray,
-                   followed: Callable[[np.ndarray], bool]) -> np.ndarray | None:
+                   followed: Callable[[np.ndarray], bool],
+                   held: Callable[[np.ndarray], np.ndarray]) -> np.ndarray | None:
     """Where no hand pointing down is reached over ``top``, on any branch (a small arm
     pressing far out and low: an SO-101 36 cm from its base), the hand leaning out from
-    the base, or back toward it, by the least of LEANS that is; its fingers close across
-    the lean, so that they stay level. None if none is."""
-    return next((R for R in (leaning_frame(world, arm, top, float(lean))
+    the base, or back toward it, by the least of LEANS that is (``held``: as the arm holds
+    it); its fingers close across the lean, so that they stay level. None if none is."""
+    return next((R for R in (held(leaning_frame(world, arm, top, float(lean)))
                              for lean in np.deg2rad(LEANS)) if followed(R)), None)
 
 
