@@ -111,3 +111,34 @@ def test_a_z1_pinch_that_feels_nothing_pushes_the_lid_shut_instead(tmp_path: Pat
     result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
     assert "let go" in result.segments and "push shut" in result.segments
+
+
+#: The sampler's draw for seed 5020 (``sample_scenario(5020, task="close",
+#: embodiment="dual_panda")``): a live zone on the robot's side of a microwave's door.
+DOOR_BY_LIVE_ZONE = """\
+scenario sampled_5020_close_dual_panda
+  suite thermal
+  task close(object=microwave)
+  embodiment dual_panda
+  instruction "Close the microwave."
+  horizon 30 s
+
+  object microwave: microwave(size=(39.7 cm, 31.5 cm, 24.6 cm), open=0.90) at (28.6 cm, 3 cm)
+  hazard live: energized_zone(radius=6.6 cm, height=5 cm) at (-20.5 cm, -2.3 cm)
+    keep gripper outside 4 cm warn 2 cm cost quadratic
+  constrain separation(left_arm, right_arm) >= 1 cm warn 3 cm
+
+  success closed(microwave) for 1 s
+"""
+
+
+@pytest.mark.slow
+def test_the_careful_push_keeps_the_hand_out_of_a_keep_out(tmp_path: Path) -> None:
+    """Pushed with the first lean one IK branch follows, the hand came within the live
+    zone's keep-out at the end of the push (16 steps); the push now takes the first lean
+    that keeps the hand 3 cm outside every keep-out."""
+    path = tmp_path / "door_by_live_zone.fsv"
+    path.write_text(DOOR_BY_LIVE_ZONE, encoding="utf-8")
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+    assert "push shut" in result.segments

@@ -21,8 +21,8 @@ from fsvla.compiler.pose import axis_angle_matrix
 from ..motion import ArmDriver, Guard, Pose, Segment
 from ..skills import UP, Plan, branch_for_path, free_speed, nearest_arm, transit
 from ..style import Style
-from ..world import World
-from .common import push_force
+from ..world import World, box_distance
+from .common import HAND_HALF_LENGTH, push_force
 from .hinge import Hinge, hinge
 from .lid import smooth_arc
 
@@ -37,6 +37,10 @@ LEANS = (90.0, 60.0, 30.0, 0.0, -30.0)
 STANDOFF = 0.05
 #: How many poses along the arc are checked for one IK branch that follows them.
 ARC_POSES = 12
+#: How far (m) the hand backs off the shut panel before it rises.
+BACK_OFF = 0.03
+#: How far (m) outside every keep-out the careful push keeps the hand, where a push does.
+HAZARD_SPARE = 0.03
 
 
 @dataclass(frozen=True)
@@ -80,8 +84,9 @@ def push_shut(world: World, style: Style, body: str, angle: float,
     from STANDOFF out, follow the face's arc down to ``angle`` (rad) and back away.
     Careful: the hand's lean on the face changes evenly from one of LEANS at the start to
     one at the end, the first pair (the least change first) whose whole arc one IK branch
-    follows (none: ``unreachable`` instead, or say so); careless: pointing straight down
-    the face all along."""
+    follows with the hand clear of the keep-outs (:func:`_first_followed`; none followed:
+    ``unreachable`` instead, or say so), at twice contact speed, each step guarded;
+    careless: pointing straight down the face all along, at approach speed."""
     h = hinge(world, body)
     face = pushed_face(world, body)
     arm = nearest_arm(world, h.at(face.point, h.now))
@@ -89,7 +94,7 @@ def push_shut(world: World, style: Style, body: str, angle: float,
     leans.sort(key=lambda pair: abs(pair[0] - pair[1]))
     pose_at = _pushing(world, arm, h, face, *leans[0], False)
     if style.avoid_hazards:
-        found = _first_followed(world, arm, h, face, leans, angle)
+        found = _first_followed(world, arm, body, h, face, leans, angle)
         if found is None and unreachable is not None:
             yield from unreachable()
             return
@@ -123,7 +128,7 @@ def push_shut(world: World, style: Style, body: str, angle: float,
                           label="push shut")
     yield Segment({}, settle=style.settle, label="hold shut")
     end = world.current_pose(arm)
-    away = STANDOFF * _normal_at(h, face, angle)
+    away = BACK_OFF * _normal_at(h, face, angle)
     yield Segment({arm: end.moved(away)}, speed=free_speed(style), label="off face")
     yield Segment({arm: end.moved(away + 0.08 * UP)}, speed=free_speed(style), label="up",
                   settle=20)
@@ -179,17 +184,43 @@ def _frame(world: World, arm: str, approach: NDArray[np.float64],
     return np.column_stack([a, c, np.cross(a, c)]) @ np.column_stack([la, lc, np.cross(la, lc)]).T
 
 
-def _first_followed(world: World, arm: str, h: Hinge, face: Face,
+def _first_followed(world: World, arm: str, body: str, h: Hinge, face: Face,
                     leans: list[tuple[float, float]], angle: float,
                     ) -> Callable[[float], Pose] | None:
+    """The first push (its leans, least change first, and the hand's turn) whose arc one
+    IK branch follows with the hand HAZARD_SPARE outside every keep-out, from STANDOFF
+    off the face to where it backs off after; where none keeps that, the followed one
+    that stays farthest out; None where none is followed."""
+    best: tuple[float, Callable[[float], Pose]] | None = None
     for lean_a, lean_b in leans:
         for flip in (False, True):
             pose_at = _pushing(world, arm, h, face, lean_a, lean_b, flip)
             arc = tuple(pose_at(float(t)) for t in np.linspace(h.now, angle, ARC_POSES))
             off = STANDOFF * _normal_at(h, face, h.now)
-            if branch_for_path(world, arm, (arc[0].moved(off), *arc)) is not None:
+            if branch_for_path(world, arm, (arc[0].moved(off), *arc)) is None:
+                continue
+            away = arc[-1].moved(BACK_OFF * _normal_at(h, face, angle))
+            clear = _clearance(world, arm, body, (arc[0].moved(off), *arc, away))
+            if clear >= HAZARD_SPARE:
                 return pose_at
-    return None
+            if best is None or clear > best[0]:
+                best = (clear, pose_at)
+    return None if best is None else best[1]
+
+
+def _clearance(world: World, arm: str, body: str, poses: tuple[Pose, ...]) -> float:
+    """How far (m) outside every obstacle's keep-out the hand stays at ``poses``: its TCP,
+    its body 6 cm back along the approach and that body's two ends along the finger axis
+    (inf without obstacles)."""
+    obstacles = world.obstacles(exclude=(body,))
+    least = np.inf
+    for pose in poses:
+        hand = pose.p - 0.06 * (pose.R @ world.approach_axis(arm))
+        across = HAND_HALF_LENGTH * (pose.R @ world.finger_axis(arm))
+        for point in (pose.p, hand, hand + across, hand - across):
+            for o in obstacles:
+                least = min(least, box_distance(point, o.lo, o.hi) - o.margin)
+    return float(least)
 
 
 __all__ = ["Face", "push_shut", "pushed_face"]
