@@ -8,13 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fsvla.env import make
 from fsvla.experts import rollout
 from fsvla.experts.skills import DOWN, horizontal
 from fsvla.experts.style import CAREFUL, CARELESS
 from fsvla.experts.tasks.press import _press_frame
 from fsvla.experts.world import World
 from fsvla.run.plan import layout_seed
+
+from .conftest import world_of
 
 pytestmark = pytest.mark.sim
 
@@ -52,21 +53,20 @@ def _write(tmp_path: Path) -> Path:
 def test_the_hand_leans_out_where_it_cannot_point_down(tmp_path: Path, style) -> None:
     """No IK answer holds the SO-101's hand pointing down 35 cm out at the block's top:
     the press frame leans out from the base (both styles: the same task plan)."""
-    env = make(str(_write(tmp_path)), "L0", SEED)
-    env.reset()
-    try:
-        world = World.of_env(env)
-        arm = world.arm_names[0]
-        lo, hi = world.bounds("block")
-        top = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.005])
+    with world_of(_write(tmp_path), SEED) as world:
+        arm, top = world.arm_names[0], _top(world)
         R = _press_frame(world, style, arm, "block", top)
         approach = R @ world.approach_axis(arm)
         out = horizontal(top - world.base_position(arm))
         lean = np.degrees(np.arccos(np.clip(approach @ DOWN, -1.0, 1.0)))
         assert 15.0 <= lean <= 70.0
         assert approach @ out > 0.2  # out, away from the base
-    finally:
-        env.close()
+
+
+def _top(world: World) -> np.ndarray:
+    """Where the press plan aims: 5 mm above the middle of the block's top."""
+    lo, hi = world.bounds("block")
+    return np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.005])
 
 
 @pytest.mark.slow
@@ -111,16 +111,9 @@ def test_the_leaning_press_frame_is_one_the_arm_holds(tmp_path: Path) -> None:
 
     path = tmp_path / "far_side_block.fsv"
     path.write_text(FAR_SIDE_BLOCK, encoding="utf-8")
-    env = make(str(path), "L0", SEED)
-    env.reset()
-    try:
-        world = World.of_env(env)
-        arm = world.arm_names[0]
-        lo, hi = world.bounds("block")
-        top = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.005])
+    with world_of(path, SEED) as world:
+        arm, top = world.arm_names[0], _top(world)
         R = _press_frame(world, CAREFUL, arm, "block", top)
         reach = world.hand_reach(arm)
         assert branch_for_path(world, arm, (Pose(top + 0.05 * UP, R),
                                             Pose(top + reach * UP, R))) is not None
-    finally:
-        env.close()

@@ -219,7 +219,9 @@ def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
         yield from push_part_closed(world, style, body)
     elif _knob_lid(world, body) and knob_pinch_fits(world, body):
         yield from lower_lid(world, style, body, SWUNG_SHUT * span,
-                             instead=lambda: push_shut(world, style, body, SWUNG_SHUT * span))
+                             instead=lambda: push_shut(
+                                 world, style, body, SWUNG_SHUT * span,
+                                 instead_of="nor could the hand hold its knob"))
     elif _handled_door(world, body) and style.avoid_hazards:
         # pushed shut, holding nothing, where the arm follows the door's face; else by its
         # handle
@@ -228,7 +230,9 @@ def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
     elif _handled_door(world, body):
         yield from swing_door(world, style, body, SWUNG_SHUT * span)
     elif _hinged_panel(world, body):
-        yield from push_shut(world, style, body, SWUNG_SHUT * span)
+        knob = _knob_lid(world, body)
+        yield from push_shut(world, style, body, SWUNG_SHUT * span, instead_of=(
+            "its knob is wider than the gripper opens" if knob else ""))
     else:
         raise NotImplementedError(_unsupported(body, part.name, joint.type, "close"))
 

@@ -79,14 +79,15 @@ def pushed_face(world: World, body: str) -> Face:
 
 
 def push_shut(world: World, style: Style, body: str, angle: float,
-              unreachable: Callable[[], Plan] | None = None) -> Plan:
+              unreachable: Callable[[], Plan] | None = None, instead_of: str = "") -> Plan:
     """Close the fingers, bring the hand onto the panel's pushed face (:func:`pushed_face`)
     from STANDOFF out, follow the face's arc down to ``angle`` (rad) and back away.
     Careful: the hand's lean on the face changes evenly from one of LEANS at the start to
     one at the end, the first pair (the least change first) whose whole arc one IK branch
     follows with the hand clear of the keep-outs (:func:`_first_followed`; none followed:
     ``unreachable`` instead, or say so), at twice contact speed, each step guarded;
-    careless: pointing straight down the face all along, at approach speed."""
+    careless: pointing straight down the face all along, at approach speed.
+    ``instead_of``: what was tried first, for the error that says none of it is done."""
     h = hinge(world, body)
     face = pushed_face(world, body)
     arm = nearest_arm(world, h.at(face.point, h.now))
@@ -102,7 +103,7 @@ def push_shut(world: World, style: Style, body: str, angle: float,
             raise NotImplementedError(
                 f"the careful expert cannot push `{body}` shut from {np.degrees(h.now):.0f}°: "
                 f"no IK branch of `{arm}` follows its face's arc with the hand on it "
-                f"(out of the arm's reach)")
+                f"(out of the arm's reach){instead_of and f'; {instead_of}'}")
         pose_at = found
     yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="fist")
     start = pose_at(h.now)
