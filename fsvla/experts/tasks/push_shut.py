@@ -32,8 +32,7 @@ PUSH_REACH = 0.65
 #: The hand's leans on the face (deg, from pointing straight into it toward pointing
 #: along it at the hinge) a push is drawn from, at its start and at its end.
 LEANS = (90.0, 60.0, 30.0, 0.0, -30.0)
-#: How far (m) from the face the hand waits before it moves onto it, and how far it
-#: backs off once the panel is shut.
+#: How far (m) from the face the hand waits before it moves onto it.
 STANDOFF = 0.05
 #: How many poses along the arc are checked for one IK branch that follows them.
 ARC_POSES = 12
@@ -91,6 +90,9 @@ def push_shut(world: World, style: Style, body: str, angle: float,
     h = hinge(world, body)
     face = pushed_face(world, body)
     arm = nearest_arm(world, h.at(face.point, h.now))
+    # the fist first: the hand's poses on the face are measured on its shut fingers (a
+    # push no arm follows hands over to ``unreachable``, which opens them as it needs)
+    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="fist")
     leans = [(np.deg2rad(a), np.deg2rad(b)) for a in LEANS for b in LEANS]
     leans.sort(key=lambda pair: abs(pair[0] - pair[1]))
     pose_at = _pushing(world, arm, h, face, *leans[0], False)
@@ -105,7 +107,6 @@ def push_shut(world: World, style: Style, body: str, angle: float,
                 f"no IK branch of `{arm}` follows its face's arc with the hand on it "
                 f"(out of the arm's reach){instead_of and f'; {instead_of}'}")
         pose_at = found
-    yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="fist")
     start = pose_at(h.now)
     off = STANDOFF * _normal_at(h, face, h.now)
     top = max(float(h.at(face.edge, h.now)[2]), start.p[2])
