@@ -12,7 +12,15 @@ from numpy.typing import NDArray
 from fsvla.compiler.pose import quat_to_matrix
 
 from .motion import Pose
-from .skills import DOWN, Grasp, attainable, fixed_jaw_shifted, horizontal, top_down_grasp
+from .skills import (
+    DOWN,
+    Grasp,
+    attainable,
+    fixed_jaw_shifted,
+    hand_body,
+    horizontal,
+    top_down_grasp,
+)
 from .style import Style
 from .world import HAND_DEPTH, World, box_distance
 
@@ -73,9 +81,8 @@ def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
     def clearance(g: Grasp) -> float:
         # the TCP and the two ends of the hand (21 cm long along the finger axis, its
         # body above the TCP): a hand lying toward a hazard reaches into its keep-out
-        closing = g.pose.R @ world.finger_axis(arm)
-        body = g.pose.p - 0.06 * g.approach
-        points = (g.pose.p, body + HAND_HALF_LENGTH * closing, body - HAND_HALF_LENGTH * closing)
+        _body, *ends = hand_body(world, arm, g.pose)
+        points = (g.pose.p, *ends)
         return min(box_distance(p, o.lo, o.hi) - o.margin for o in obstacles for p in points)
 
     return max(found, key=clearance)
@@ -138,8 +145,6 @@ def _grip_height(world: World, arm: str, obj: str, h: float) -> tuple[float, flo
 
 
 UPV = np.array([0.0, 0.0, 1.0])
-#: Half the length of a Panda hand along its finger axis (m), with its collision hull.
-HAND_HALF_LENGTH = 0.105
 
 
 def _mug(world: World, arm: str, obj: str) -> list[Grasp]:

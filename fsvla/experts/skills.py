@@ -75,6 +75,8 @@ REACH_SLACK = 0.05
 SAG = 0.02
 #: Height of the hand above its tool centre point (m), for clearing obstacles beneath it.
 HAND_RADIUS = 0.06
+#: Half the length of a Panda hand along its finger axis (m), with its collision hull.
+HAND_HALF_LENGTH = 0.105
 
 Plan = Iterator[Segment]
 
@@ -665,6 +667,16 @@ def leaning_frame(world: World, arm: str, point: NDArray[np.float64],
                              np.cross(UP, out))
 
 
+def hand_body(world: World, arm: str, pose: Pose) -> tuple[NDArray[np.float64], ...]:
+    """The points that stand for ``arm``'s hand at ``pose`` in a clearance check, besides
+    its TCP: its body, HAND_RADIUS behind the TCP along the approach, and that body's two
+    ends HAND_HALF_LENGTH out along the finger axis (a hand lying toward a hazard reaches
+    into its keep-out)."""
+    body = pose.p - HAND_RADIUS * (pose.R @ world.approach_axis(arm))
+    across = HAND_HALF_LENGTH * (pose.R @ world.finger_axis(arm))
+    return body, body + across, body - across
+
+
 def top_down_grasp(world: World, arm: str, centre: NDArray[np.float64],
                    closing: NDArray[np.float64], width: float) -> Grasp:
     R = world.grasp_frame(arm, DOWN, closing)
@@ -726,6 +738,7 @@ __all__ = [
     "grasp_tip",
     "grip_force",
     "grip_guard",
+    "hand_body",
     "held_offset",
     "horizontal",
     "jaws_clear_of_support",

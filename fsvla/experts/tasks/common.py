@@ -11,6 +11,7 @@ from fsvla.dsl.models import predicates_in
 
 from ..motion import Pose, Segment
 from ..skills import (
+    HAND_HALF_LENGTH,
     REACH_SLACK,
     UP,
     Plan,
@@ -22,9 +23,6 @@ from ..skills import (
 )
 from ..style import Style
 from ..world import World, box_distance
-
-#: Half the length of a Panda hand along its finger axis (m), with its collision hull.
-HAND_HALF_LENGTH = 0.105
 
 #: Half the thickness of a Panda hand across its finger axis (m).
 HAND_HALF_WIDTH = 0.032

@@ -15,6 +15,7 @@ from ..skills import (
     branch_for_path,
     carrying_arm,
     fixed_jaw_shifted,
+    hand_body,
     horizontal,
     load_reach,
     pick,
@@ -23,7 +24,7 @@ from ..skills import (
 )
 from ..style import Style
 from ..world import World, box_distance
-from .common import HAND_HALF_LENGTH, required_tilt
+from .common import required_tilt
 
 #: How high (m) above the target's top the held object's bottom is carried to pour; the
 #: careful expert POUR_MARGIN higher (a mug held by its handle hangs turned in the fingers,
@@ -132,9 +133,8 @@ def _clear(world: World, arm: str, obj: str, target: str, over: Pose, way: Pose,
         R = slerp(over.R, way.R, s)
         p = over.p + s * (way.p - over.p)
         c = p + R @ centre
-        body = p - 0.06 * (R @ world.approach_axis(arm))
-        across = HAND_HALF_LENGTH * (R @ world.finger_axis(arm))
-        for point, size in ((p, 0.0), (body + across, 0.0), (body - across, 0.0),
+        _body, end_a, end_b = hand_body(world, arm, Pose(p, R))
+        for point, size in ((p, 0.0), (end_a, 0.0), (end_b, 0.0),
                             (c, float(max(half[0], half[1]))),
                             (c + R @ up * half[2], 0.0), (c - R @ up * half[2], 0.0)):
             if min(box_distance(point, o.lo, o.hi) - o.margin for o in obstacles) \

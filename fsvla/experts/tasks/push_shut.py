@@ -18,11 +18,20 @@ from numpy.typing import NDArray
 
 from fsvla.compiler.pose import axis_angle_matrix
 
-from ..motion import ArmDriver, Guard, Pose, Segment
-from ..skills import UP, Plan, branch_for_path, free_speed, nearest_arm, transit
+from ..motion import Guard, Pose, Segment
+from ..skills import (
+    UP,
+    Plan,
+    attained,
+    branch_for_path,
+    free_speed,
+    hand_body,
+    nearest_arm,
+    transit,
+)
 from ..style import Style
 from ..world import World, box_distance
-from .common import HAND_HALF_LENGTH, push_force
+from .common import push_force
 from .hinge import Hinge, hinge
 from .lid import smooth_arc
 
@@ -148,7 +157,6 @@ def _pushing(world: World, arm: str, h: Hinge, face: Face, lean_a: float, lean_b
     from pointing into the face (0) toward pointing along it at the hinge (90 deg), its
     fingers closing along the hinge (``flip``: the hand turned half a turn about its
     approach). The TCP stands off the face as far as the hand's hulls reach past it."""
-    fixed = len(world.arm_joints(arm)) >= 6
     span = h.now if h.now > 0 else 1.0
     cache: dict[float, Pose] = {}
 
@@ -162,13 +170,10 @@ def _pushing(world: World, arm: str, h: Hinge, face: Face, lean_a: float, lean_b
         approach = -(np.cos(lean) * normal + np.sin(lean) * outward)
         R = _frame(world, arm, approach, -h.axis if flip else h.axis)
         point = h.at(face.point, theta)
-        for _ in range(2 if not fixed else 1):
-            stand = world.hand_front(arm, R, -normal, np.zeros(3), np.inf)
-            pose = Pose(point + normal * stand, R)
-            if fixed:
-                break
-            R = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
-                          world.arm_joints(arm), 1.0).attainable(pose).R
+        pose = Pose(point + normal * world.hand_front(arm, R, -normal, np.zeros(3), np.inf), R)
+        if len(world.arm_joints(arm)) < 6:  # turned to what a five-joint arm holds there
+            R = attained(world, arm, pose).R
+            pose = Pose(point + normal * world.hand_front(arm, R, -normal, np.zeros(3), np.inf), R)
         cache[theta] = pose
         return pose
 
@@ -217,9 +222,7 @@ def _clearance(world: World, arm: str, body: str, poses: tuple[Pose, ...]) -> fl
     obstacles = world.obstacles(exclude=(body,))
     least = np.inf
     for pose in poses:
-        hand = pose.p - 0.06 * (pose.R @ world.approach_axis(arm))
-        across = HAND_HALF_LENGTH * (pose.R @ world.finger_axis(arm))
-        for point in (pose.p, hand, hand + across, hand - across):
+        for point in (pose.p, *hand_body(world, arm, pose)):
             for o in obstacles:
                 least = min(least, box_distance(point, o.lo, o.hi) - o.margin)
     return float(least)
