@@ -35,6 +35,7 @@ from ..skills import (
     force_watched,
     free_speed,
     gentle,
+    horizontal,
     load_reach,
     reach_ceiling,
     transit,
@@ -168,11 +169,12 @@ def _cavity(world: World, target: str) -> tuple[NDArray[np.float64], float, floa
 
 
 def release_pose(world: World, arm: str, obj: str, target: str, clear: float = 0.0,
-                 turns: tuple[float, ...] = TURNS) -> list[tuple[float, Pose]]:
+                 turns: tuple[float, ...] = TURNS, lean: float = 0.0) -> list[tuple[float, Pose]]:
     """Where the hand holding ``obj`` as it does now lets it go over ``target``'s cavity:
     (how far the object drops, TCP pose), best first, over the object's centre set on a
-    few rings inside the cavity and the hand's ``turns`` about the vertical; ``clear``:
-    how far (m) above what is beneath it the object would be let go at best."""
+    few rings inside the cavity and the hand's ``turns`` about the vertical, then leant by
+    ``lean`` (rad) out, away from the arm's base; ``clear``: how far (m) above what is
+    beneath it the object would be let go at best."""
     tcp = world.current_pose(arm)
     hand = hand_points(world, arm, RELEASE_GAP)
     held = object_points(world, arm, obj)
@@ -186,9 +188,11 @@ def release_pose(world: World, arm: str, obj: str, target: str, clear: float = 0
                              for a in np.linspace(0.0, 2 * np.pi, 8, endpoint=False)]
     # an arm of fewer than six joints turns the hand as it turns to the cavity
     bearing = carried_rotation(world, arm, floor) @ tcp.R.T
+    out = horizontal(floor - world.base_position(arm))
+    leant = axis_angle_matrix(np.cross(out, UP), lean)
     options = []
     for k, angle in enumerate(turns):
-        turn = axis_angle_matrix(UP, angle) @ bearing
+        turn = leant @ axis_angle_matrix(UP, angle) @ bearing
         R = turn @ tcp.R
         off = turn @ centre_off
         h, o = hand @ R.T, held @ R.T
@@ -213,6 +217,25 @@ def _holds(world: World, arm: str, obj: str) -> bool:
             and world.hand_force(arm, obj) > 0.0)
 
 
+#: Leans (rad) of the hand out from the arm's base tried in turn where the arm follows
+#: no descent onto a release pose with the hand as it holds the object: a container near
+#: the end of the arm's reach (Baxter's 90 cm out) is reached only by a hand pointing
+#: forward, as a reach over a table is.
+LEANS = (0.0, np.radians(25.0), np.radians(40.0), np.radians(55.0))
+
+
+def _release_followed(world: World, arm: str, obj: str, target: str, clear: float) -> Pose:
+    """The release pose (:func:`release_pose`) the hand comes down onto: among the first
+    eight of the least lean the arm follows a descent onto, the best; else the best with
+    the hand as it is."""
+    for lean in LEANS:
+        options = release_pose(world, arm, obj, target, clear, lean=lean)
+        for _drop, pose in options[:8]:  # the first whose descent the arm follows comfortably
+            if branch_for_path(world, arm, (pose.moved(0.08 * UP), pose)) is not None:
+                return pose
+    return release_pose(world, arm, obj, target, clear)[0][1]
+
+
 def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
                     retreat: float = 0.1) -> Plan:
     """Carry the held ``obj`` over ``target``'s cavity, come down (guarded) to the lowest
@@ -224,12 +247,7 @@ def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
         return
     fragile = force_watched(world, obj)
     clear = 0.0 if fragile else style.release_height
-    options = release_pose(world, arm, obj, target, clear)
-    goal = options[0][1]
-    for drop, pose in options[:8]:  # the first whose descent the arm follows comfortably
-        if branch_for_path(world, arm, (pose.moved(0.08 * UP), pose)) is not None:
-            goal = pose
-            break
+    goal = _release_followed(world, arm, obj, target, clear)
     tcp = world.current_pose(arm)
     below = float(tcp.p[2] - world.bounds(obj)[0][2]) + 0.03
     heavy = float(world.asset(obj).mass) > LIGHT_LOAD
