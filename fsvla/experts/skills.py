@@ -144,6 +144,22 @@ def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
     return replace(style, grip_force=force)
 
 
+def grip_force_cap(world: World, obj: str) -> float | None:
+    """The most squeeze (N) a careful grip on ``obj`` may use: half of the least contact
+    force limit on the gripper or the object (:func:`grip_force`); None without one."""
+    names = {obj, *world.gripper_entities}
+    caps = [0.5 * channel.limit for channel in world.monitor.channels
+            if channel.metric == "contact_force" and set(channel.subjects) & names]
+    return min(caps) if caps else None
+
+
+def holdable_lever(world: World, obj: str, force: float, weight_factor: float = 2.0) -> float:
+    """How far (m) from the centre of ``obj`` a squeeze of ``force`` (N) holds it without
+    its weight turning it in the fingers (:data:`PAD_RADIUS`; :func:`grip_force`)."""
+    weight = weight_factor * float(world.asset(obj).mass) * 9.81
+    return force * 2 * 0.5 * PAD_RADIUS / weight
+
+
 def _grasp_offset(world: World, arm: str, obj: str,
                   tcp: Pose | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(centre of ``obj`` minus the grasp at ``tcp``, default where the hand is; the
@@ -478,7 +494,8 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     out of contact as the hand backs off, which reads as grasping it again. ``by_lowest``:
     a load that hangs more than SAG below its origin is set down by its lowest point (a
     bar held by its end; a knife held by its handle instead lies down as the hand lowers
-    on, turning in the fingers, and is not raised)."""
+    on, turning in the fingers, and is not raised); careful, it is then laid flat
+    (:func:`lay_down`) before the fingers open."""
     R = carried_rotation(world, arm, bottom) if rotation is None else rotation
     offset = R @ held_offset(world, arm, obj)
     goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
@@ -506,6 +523,8 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     yield Segment({arm: goal.moved(0.02 * UP)}, speed=style.approach_speed, label="lower")
     yield Segment({arm: goal}, speed=gentle(world, style, obj), settle=style.settle // 2,
                   label="touch")
+    if sag > 0.0 and style.avoid_hazards:
+        yield from lay_down(world, style, arm, obj)
     opening = 1.0 if release_gap is None else min(
         1.0, world.gripper_opening(arm) + 2 * release_gap / world.max_width(arm))
     yield Segment(grippers={arm: opening},
@@ -513,6 +532,58 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
                   settle=style.settle, label="release")
     back = -world.current_pose(arm).R @ world.approach_axis(arm)
     yield Segment({arm: goal.moved(retreat * back)}, speed=free_speed(style), label="retreat")
+
+
+#: The guard of a careful lay-down (:func:`lay_down`): it stops the hand once it feels
+#: this much (N) more than its squeeze on the load, or this share of a contact force
+#: limit on the load where that is less (what the hand feels more, the load's low end
+#: presses on the support).
+LAY_DOWN_SPARE = 3.0
+LAY_DOWN_SHARE = 0.2
+#: Largest turn (rad) of one straight step of the hand along a lay-down's arc.
+LAY_DOWN_STEP = np.radians(8.0)
+#: How many times at most the careful hand then lowers on by what the load still hangs.
+LAY_DOWN_ROUNDS = 4
+
+
+def lay_down(world: World, style: Style, arm: str, obj: str) -> Plan:
+    """Lay the held ``obj``, tilted in the fingers and its low end on the support, flat:
+    the hand turns it about that end, along the arc its grip follows, turning with it (a
+    hand lowered straight down drags the end across the support and stalls at half the
+    tilt, and the load let go from there lands hard; a bar taken near its middle does not
+    turn in the fingers). Guarded: a load that will not turn presses on the hand."""
+    pose = world.body_pose(obj)
+    up = pose.R[:, 2]
+    tilt = float(np.arccos(np.clip(up @ UP, -1.0, 1.0)))
+    axis = np.cross(up, UP)
+    if tilt <= LAY_DOWN_STEP / 2 or float(np.linalg.norm(axis)) < 1e-9:
+        return
+    b = world.asset(obj).bounds
+    centre, half = np.asarray(b.center), np.asarray(b.half_extents)
+    corners = np.array([centre + half * np.array([x, y, z]) for x in (-1, 1)
+                        for y in (-1, 1) for z in (-1, 1)]) @ pose.R.T + pose.p
+    low = corners[corners[:, 2] <= corners[:, 2].min() + 0.005].mean(axis=0)  # its low end
+    limit = world.force_limit(obj)
+    spare = LAY_DOWN_SPARE if limit is None else min(LAY_DOWN_SPARE, LAY_DOWN_SHARE * limit)
+    guard = Guard(arm, world.hand_force(arm, obj) + spare, obj)
+    tcp = world.current_pose(arm)
+    steps = int(np.ceil(tilt / LAY_DOWN_STEP))
+    arc = [tcp] + [Pose(low + turn @ (tcp.p - low), turn @ tcp.R) for turn in (
+        axis_angle_matrix(axis, tilt * k / steps) for k in range(1, steps + 1))]
+    # as far along the arc as the arm follows it (a Panda's wrist turning a low hand
+    # meets its limit part way)
+    followed = next((k for k in range(steps, 0, -1)
+                     if branch_for_path(world, arm, tuple(arc[:k + 1])) is not None), 0)
+    for pose in arc[1:followed + 1]:
+        yield Segment({arm: pose}, speed=gentle(world, style, obj), guards=(guard,),
+                      label="lay down")
+    # what it still hangs: the hand lowers on straight, the load turning in the fingers
+    for _ in range(LAY_DOWN_ROUNDS):
+        rest, now = hanging(world, obj), world.current_pose(arm)
+        if rest <= 0.0 or world.hand_force(arm, obj) >= guard.force:
+            break
+        yield Segment({arm: Pose(now.p - rest * UP, now.R)}, speed=gentle(world, style, obj),
+                      settle=style.settle // 2, guards=(guard,), label="lay down")
 
 
 def hanging(world: World, obj: str) -> float:
@@ -737,11 +808,14 @@ __all__ = [
     "grasp_lever",
     "grasp_tip",
     "grip_force",
+    "grip_force_cap",
     "grip_guard",
     "hand_body",
     "held_offset",
+    "holdable_lever",
     "horizontal",
     "jaws_clear_of_support",
+    "lay_down",
     "leaning_frame",
     "load_reach",
     "nearest_arm",

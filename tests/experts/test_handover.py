@@ -200,3 +200,56 @@ def test_the_taker_feels_its_grip_before_the_giver_lets_go(tmp_path: Path) -> No
     result = rollout(str(path), "careful", "L2", SEED)
     assert "squeeze" in result.segments[result.segments.index("take"):]
     assert result.safe_success, result.summary()
+
+
+def test_a_bar_the_grip_cannot_hold_by_its_end_is_taken_nearer_its_middle(tmp_path: Path) -> None:
+    """Under draw 43's 23 N limit on the bar, a squeeze of half of it does not hold a
+    119 g bar from turning 5.8 cm out: the careful taker takes it as near its middle as
+    the squeeze holds, the hands kept HANDS_APART; with no force limit, by its end."""
+    from fsvla.env import make
+    from fsvla.experts.skills import grip_force, grip_force_cap, holdable_lever
+    from fsvla.experts.tasks import handover as H
+
+    path = tmp_path / "loose.fsv"
+    path.write_text(LOOSE_TAKE, encoding="utf-8")
+    env = make(str(path), "L0", SEED)
+    env.reset()
+    world = World.of_env(env)
+    bar = H._Bar.of(world, "block")
+    end = float(bar.half[0]) - H.END_GRASP
+    cap = grip_force_cap(world, "block")
+    assert cap == pytest.approx(11.5)
+    lever = holdable_lever(world, "block", cap)
+    # the squeeze that holds the bar that far out is the most the limits allow
+    assert grip_force(world, "block", CAREFUL, lever=lever).grip_force == pytest.approx(cap)
+    take_at = H._take_offset(world, "block", bar, H.END_GRASP)
+    assert take_at < end - 0.02
+    assert take_at == pytest.approx(max(lever, H.HANDS_APART - end))
+    _e, meet = H._plan_exchange(world, CAREFUL, "block", "left", "right")
+    assert meet.take_at == pytest.approx(H._take_offset(world, "block", bar, meet.inset))
+    env.close()
+
+    env = make(str(_write(tmp_path, "baxter", "-21 cm")), "L0", SEED)
+    env.reset()
+    world = World.of_env(env)
+    bar = H._Bar.of(world, "block")
+    assert H._take_offset(world, "block", bar, H.END_GRASP) == float(bar.half[0]) - H.END_GRASP
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("text", "level"), [(LOOSE_TAKE, "L0"), (LOOSE_TAKE, "L1"),
+                                             (TILTED_BAR, "L1")])
+def test_a_bar_the_grip_cannot_hold_level_is_handed_over_and_laid_down(
+        tmp_path: Path, text: str, level: str) -> None:
+    """Draw 43: taken by its end, the bar swung out of Baxter's fingers as the giver let go
+    (`landing` ×2-3); taken nearer its middle it stays. Draw 32 at L1: the bar, hanging
+    50 deg in the giver's fingers, is taken by its end as it hangs and, its low end on the
+    plate, laid flat by the hand turning it about that end (let go tilted, it did not
+    stay on the plate: a safe failure)."""
+    path = tmp_path / "bar.fsv"
+    path.write_text(text, encoding="utf-8")
+    result = rollout(str(path), "careful", level, SEED)
+    assert result.safe_success, result.summary()
+    if text is TILTED_BAR:
+        assert "lay down" in result.segments

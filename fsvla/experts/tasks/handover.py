@@ -21,6 +21,8 @@ from ..skills import (
     free_speed,
     grasp_lever,
     grip_force,
+    grip_force_cap,
+    holdable_lever,
     horizontal,
     nearest_arm,
     opening_for,
@@ -159,8 +161,9 @@ class _Bar:
 @dataclass(frozen=True)
 class _Exchange:
     """Where a long object changes hands: its middle there, the inset of the giver's hand
-    from its end, how far from the middle the taker takes it (careful: as far as the giver;
-    careless: at the middle, leaving the arms no room apart),
+    from its end, how far from the middle the taker takes it (careful: as far as the giver,
+    or nearer where its squeeze is capped, :func:`_take_offset`; careless: at the middle,
+    leaving the arms no room apart),
     how far before its take pose (along the approach) the taker's free-space move
     ends (m), and how far the taker's hand leans away from the giver's (rad)."""
 
@@ -278,6 +281,33 @@ def _exchange_margin(world: World, gap: ArmGap, giver: str, taker: str, q_giver,
     return margin if gap.aligned(q_giver, q_take) else margin - UNALIGNED
 
 
+#: How far apart (m) along the object the careful hands hold it at least while it
+#: changes hands (a Panda hand's body is 6 cm thick along it).
+HANDS_APART = 0.08
+#: How far (rad) from level a long object hangs in the giver's hand for the careful
+#: taker to take it by its end whatever its grip holds (:func:`_take_offset`).
+HANGS_TILTED = np.radians(15.0)
+
+
+def _tilt(bar: _Bar) -> float:
+    """How far (rad) the bar's long axis is from level."""
+    return float(np.arcsin(min(1.0, abs(float(bar.line[2])) / float(np.linalg.norm(bar.line)))))
+
+
+def _take_offset(world: World, obj: str, bar: _Bar, inset: float) -> float:
+    """How far from the middle (m) the careful taker takes a long object the giver holds
+    ``inset`` from its other end: as far as the giver, unless a force limit caps its
+    squeeze below what holds the object's weight from turning in the fingers that far out
+    (:func:`~fsvla.experts.skills.holdable_lever`; a 119 g bar held 5.8 cm out under a
+    23 N limit swung out of Baxter's fingers as the giver let go); then nearer the middle,
+    keeping the hands HANDS_APART."""
+    out = float(bar.half[0]) - inset
+    cap = grip_force_cap(world, obj)
+    if cap is None:
+        return out
+    return min(out, max(holdable_lever(world, obj, cap), HANDS_APART - out))
+
+
 def _plan_exchange(world: World, style: Style, obj: str, giver: str,
                    taker: str) -> tuple[float, _Exchange]:
     """Before the pick: which end the giver takes, and where the hands meet. Careful, with
@@ -292,7 +322,8 @@ def _plan_exchange(world: World, style: Style, obj: str, giver: str,
     meetings = _meeting_options(world, style, obj, giver, taker)
     if not style.avoid_hazards:  # the taker's point is chosen once the giver holds it out
         return ends[0], _Exchange(meetings[0], INSETS[0], 0.0, ABOVE[0])
-    first = (ends[0], _Exchange(meetings[0], INSETS[0], float(bar.half[0]) - INSETS[0], ABOVE[0]))
+    take_at = {inset: _take_offset(world, obj, bar, inset) for inset in INSETS}
+    first = (ends[0], _Exchange(meetings[0], INSETS[0], take_at[INSETS[0]], ABOVE[0]))
     gap = ArmGap(world, giver, taker)
     if not gap.watched:
         return first
@@ -308,14 +339,13 @@ def _plan_exchange(world: World, style: Style, obj: str, giver: str,
                 if q_giver is None:
                     continue
                 for tilt in TILTS:
-                    grasp = _taker_grasp(world, taker, bar, middle, toward,
-                                         float(bar.half[0]) - inset, tilt)
+                    grasp = _taker_grasp(world, taker, bar, middle, toward, take_at[inset],
+                                         tilt)
                     for above in ABOVE:
                         margin = _exchange_margin(world, gap, giver, taker, q_giver, grasp,
                                                   above)
                         if margin > best_margin:
-                            best = (e, _Exchange(middle, inset, float(bar.half[0]) - inset,
-                                                 above, tilt))
+                            best = (e, _Exchange(middle, inset, take_at[inset], above, tilt))
                             best_margin = margin
                         if margin >= GAP_SLACK:
                             return best
@@ -369,6 +399,10 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
     now = _Bar.of(world, obj)
     line = now.line if now.line @ toward >= 0 else -now.line
     take_at = meet.take_at if style.avoid_hazards else 0.0  # careless: the middle
+    if style.avoid_hazards and _tilt(now) > HANGS_TILTED:
+        # it has turned in the giver's fingers and hangs: taken by its far end as it is, it
+        # hangs from the taker's as it did from the giver's
+        take_at = float(now.half[0]) - meet.inset
     take = _taker_grasp(world, taker, now, now.centre, line, take_at, meet.tilt)
     above = meet.above
     gap = ArmGap(world, giver, taker)
