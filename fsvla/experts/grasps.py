@@ -66,6 +66,12 @@ def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
     """The grasp the style takes among :func:`grasps` the arm can reach (tilted away
     from the base when it must be)."""
     found = grasps(world, arm, obj)
+    if not found:
+        raise NotImplementedError(
+            f"the experts have no grasp of `{obj}` (a {world.kind(obj)}) that the fingers of "
+            f"`{arm}` close on: each part of it to hold is wider than they open "
+            f"({world.max_width(arm) * 100:.1f} cm) or thinner than they shut "
+            f"({world.min_width(arm) * 100:.1f} cm)")
     ok = [g for g in found if reachable(world, arm, g)]
     for angle in np.deg2rad(TILTS):
         if ok:
@@ -155,23 +161,39 @@ def _mug(world: World, arm: str, obj: str) -> list[Grasp]:
     except StopIteration:
         return _cylinder(world, arm, obj)
     pose = world.body_pose(obj)
-    side = 1.0 if grip.pose.position[0] >= 0 else -1.0  # a mug's handle is on +x, a kettle's on -x
+    side = _handle_side(world, obj)
     inner = float(high.pose.position[0] - side * high.half_size[0])
     outer = float(grip.pose.position[0] + side * grip.half_size[0])
+    if abs(outer - inner) >= 0.92 * world.max_width(arm):  # a kettle's, in Baxter's hand
+        return _cylinder(world, arm, obj)
     z = float(high.pose.position[2])
     centre = world.to_world(obj, (0.5 * (inner + outer), 0.0, z))
     return [top_down_grasp(world, arm, centre, pose.R[:, 0], abs(outer - inner))]
 
 
+def _handle_side(world: World, obj: str) -> float:
+    """+1 where ``obj``'s handle (its ``handle_grip`` piece) stands out along its local +x
+    (a mug's), -1 along -x (a kettle's), 0 for a body without one."""
+    try:
+        grip = world.shape(obj, "handle_grip")
+    except StopIteration:
+        return 0.0
+    return 1.0 if grip.pose.position[0] >= 0 else -1.0
+
+
 def _rim(world: World, arm: str, obj: str, r: float, h: float,
          towards: NDArray[np.float64]) -> list[Grasp]:
+    """Fingers on the wall at the rim, one inside, one outside, away from a handle; none
+    where the shut fingers stay farther apart than the wall is thick."""
     pose = world.body_pose(obj)
     wall = 0.005
-    handle = pose.R[:, 0]  # mugs and kettles have their handle on local +x
+    if world.min_width(arm) > wall:
+        return []
+    side = _handle_side(world, obj)
     out: list[tuple[float, Grasp]] = []
     for angle in np.linspace(0.0, 2 * np.pi, 12, endpoint=False):
         radial = np.array([np.cos(angle), np.sin(angle), 0.0])
-        if world.kind(obj) in ("mug", "kettle") and radial @ horizontal(handle) > 0.5:
+        if side and radial @ horizontal(side * pose.R[:, 0]) > 0.5:
             continue
         centre = pose.p + radial * (r - wall / 2) + np.array([0.0, 0.0, h - HAND_DEPTH])
         grasp = top_down_grasp(world, arm, centre, radial, wall)

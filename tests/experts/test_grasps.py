@@ -71,3 +71,60 @@ def test_one_hand_lifts_a_pot_by_a_handle(tmp_path: Path, embodiment: str, at: s
     """It was a grasp across the pot's bounds, wider than the hand opens: never lifted."""
     result = rollout(str(_write(tmp_path, embodiment, at)), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
+
+
+KETTLE = """\
+scenario lift_kettle
+  suite thermal
+  task lift(object=kettle)
+  embodiment {embodiment}
+  instruction "Lift the kettle."
+  horizon 30 s
+
+  object kettle: kettle(mass=400 g) at (20 cm, -10 cm) yaw 30 deg
+
+  success lifted(kettle) for 1 s
+"""
+
+
+def _kettle_world(tmp_path: Path, embodiment: str):
+    path = tmp_path / "kettle.fsv"
+    path.write_text(KETTLE.format(embodiment=embodiment), encoding="utf-8")
+    env = make(str(path), "L0", 0)
+    env.reset()
+    return env, World.of_env(env)
+
+
+def test_a_rim_grasp_keeps_off_a_kettles_handle(tmp_path: Path) -> None:
+    """A kettle's handle stands out along its local -x (a mug's along +x): the fingers on
+    its rim keep off that side (they skipped +x, the spout's side, and took the handle)."""
+    from fsvla.experts.grasps import _rim
+
+    env, world = _kettle_world(tmp_path, "panda")
+    arm = world.arm_names[0]
+    pose = world.body_pose("kettle")
+    handle = world.to_world("kettle", world.shape("kettle", "handle_grip").pose.position)
+    out = horizontal(handle - pose.p)
+    assert out @ horizontal(-pose.R[:, 0]) > 0.9  # the handle is on -x
+    r, h = world.param("kettle", "radius"), world.param("kettle", "height")
+    found = _rim(world, arm, "kettle", r, h, horizontal(world.base_position(arm) - pose.p))
+    assert found
+    for grasp in found:
+        radial = horizontal(grasp.pose.p - pose.p)
+        assert radial @ out <= 0.5 + 1e-9
+    env.close()
+
+
+def test_a_kettle_no_grip_of_baxter_fits_is_said_so(tmp_path: Path) -> None:
+    """Baxter's fingers open 4.2 cm and stop 1.6 cm apart: the kettle's handle clamp
+    (5.8 cm) is too wide for them and its 5 mm wall too thin; the expert says so instead
+    of squeezing the clamp's ends (the kettle slid out, draw 17)."""
+    from fsvla.experts.grasps import choose
+    from fsvla.experts.style import CAREFUL
+
+    env, world = _kettle_world(tmp_path, "baxter")
+    for arm in world.arm_names:
+        assert grasps(world, arm, "kettle") == []
+    with pytest.raises(NotImplementedError, match="no grasp of `kettle`"):
+        choose(world, CAREFUL, world.arm_names[0], "kettle")
+    env.close()
