@@ -147,10 +147,8 @@ def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
 def grip_force_cap(world: World, obj: str) -> float | None:
     """The most squeeze (N) a careful grip on ``obj`` may use: half of the least contact
     force limit on the gripper or the object (:func:`grip_force`); None without one."""
-    names = {obj, *world.gripper_entities}
-    caps = [0.5 * channel.limit for channel in world.monitor.channels
-            if channel.metric == "contact_force" and set(channel.subjects) & names]
-    return min(caps) if caps else None
+    limit = world.force_limit(obj, *world.gripper_entities)
+    return None if limit is None else 0.5 * limit
 
 
 def holdable_lever(world: World, obj: str, force: float, weight_factor: float = 2.0) -> float:
@@ -558,10 +556,7 @@ def lay_down(world: World, style: Style, arm: str, obj: str) -> Plan:
     axis = np.cross(up, UP)
     if tilt <= LAY_DOWN_STEP / 2 or float(np.linalg.norm(axis)) < 1e-9:
         return
-    b = world.asset(obj).bounds
-    centre, half = np.asarray(b.center), np.asarray(b.half_extents)
-    corners = np.array([centre + half * np.array([x, y, z]) for x in (-1, 1)
-                        for y in (-1, 1) for z in (-1, 1)]) @ pose.R.T + pose.p
+    corners = world.corners(obj)
     low = corners[corners[:, 2] <= corners[:, 2].min() + 0.005].mean(axis=0)  # its low end
     limit = world.force_limit(obj)
     spare = LAY_DOWN_SPARE if limit is None else min(LAY_DOWN_SPARE, LAY_DOWN_SHARE * limit)

@@ -101,15 +101,19 @@ class World:
         pose = self.body_pose(body)
         return pose.R @ np.asarray(local, dtype=np.float64) + pose.p
 
-    def bounds(self, body: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """World axis-aligned bounds of a body's asset bounds at its current pose."""
+    def corners(self, body: str) -> NDArray[np.float64]:
+        """The eight corners (8 × 3, world) of a body's asset bounds at its current pose."""
         b = self.asset(body).bounds
         centre, half = np.asarray(b.center), np.asarray(b.half_extents)
         lo, hi = centre - half, centre + half
         corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
                             for z in (lo[2], hi[2])])
         pose = self.body_pose(body)
-        world = corners @ pose.R.T + pose.p
+        return corners @ pose.R.T + pose.p
+
+    def bounds(self, body: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """World axis-aligned bounds of a body's asset bounds at its current pose."""
+        world = self.corners(body)
         return world.min(axis=0), world.max(axis=0)
 
     def top(self, body: str) -> float:

@@ -228,12 +228,14 @@ def _release_followed(world: World, arm: str, obj: str, target: str, clear: floa
     """The release pose (:func:`release_pose`) the hand comes down onto: among the first
     eight of the least lean the arm follows a descent onto, the best; else the best with
     the hand as it is."""
+    upright = release_pose(world, arm, obj, target, clear)
     for lean in LEANS:
-        options = release_pose(world, arm, obj, target, clear, lean=lean)
+        options = upright if lean == 0.0 else release_pose(world, arm, obj, target, clear,
+                                                            lean=lean)
         for _drop, pose in options[:8]:  # the first whose descent the arm follows comfortably
             if branch_for_path(world, arm, (pose.moved(0.08 * UP), pose)) is not None:
                 return pose
-    return release_pose(world, arm, obj, target, clear)[0][1]
+    return upright[0][1]
 
 
 def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
