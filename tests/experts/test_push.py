@@ -77,6 +77,25 @@ def test_careful_expert_pushes_the_block_safely(scenario: Path) -> None:
     assert careful.safe_success, (careful.violated, careful.segments[-5:])
 
 
+def shut_world(path: Path, obj: str = "block", target: str = "other_block"):
+    """As :func:`reset_world`, once the careful expert has shut the hand for the push (the
+    route is laid out on the shut hand)."""
+    from fsvla.env import make
+    from fsvla.experts.policy import make_expert
+
+    env = make(str(path), "L0", SEED)
+    expert = make_expert(env, "careful")
+    obs, _ = env.reset()
+    expert.reset(None)
+    step = 0
+    for action in expert.act(obs):  # the first segment: the fingers shut
+        obs, *_ = env.step(action)
+        step += 1
+    assert set(expert.labels[:step]) == {"close"}
+    world = World.of_env(env)
+    return env, world, world.body_pose(obj).p, world.body_pose(target).p
+
+
 #: The sampler's draw 123 (``fsvla.validate.sampler``, seed 123): an SO-101 pushes a block
 #: 12 cm sideways, 35 cm out from its base. No one turn of its hand is held along the push
 #: (a five-joint arm turns its hand with the direction to its base), so it pushes in legs.
@@ -114,13 +133,13 @@ def test_a_push_no_one_turn_follows_is_made_in_legs_the_arm_follows(far_sideways
     from fsvla.experts.skills import branch_for_path, horizontal, nearest_arm
     from fsvla.experts.tasks.push import _off_the_table, _push_frame, _push_line, _push_route
 
-    env, world, start, goal = reset_world(far_sideways)
+    env, world, start, goal = shut_world(far_sideways)
     arm = nearest_arm(world, start)
     bounds = world.bounds("block")
     line, direction, travel = _push_line(world, "block", start, goal, bounds)
     assert _push_frame(world, arm, line, direction, travel) is None
     behind = _off_the_table(world, arm, line, bounds)
-    route = _push_route(world, arm, behind, direction, travel)
+    route = _push_route(world, arm, behind, direction, travel, world.top("block"))
     assert route is not None
     pose_at, length, whole = route
     assert 0.01 < length and not whole  # a first leg, short of the target
@@ -202,4 +221,87 @@ def test_the_hand_front_is_measured_on_its_hulls(wide_hand: Path, scenario: Path
 @pytest.mark.parametrize("level", ["L0", "L1", "L2"])
 def test_the_z1_starts_its_push_with_its_jaws_clear_of_the_mug(wide_hand: Path, level: str) -> None:
     careful = rollout(str(wide_hand), "careful", level, SEED)
+    assert careful.safe_success, (careful.violated, careful.segments)
+
+
+#: The sampler's draw 68: the SO-101 pushes a block 34 cm from its base across to its
+#: right. It leans its hand out for the push; 8 cm above the push's start its wrist does
+#: not hold that lean within its limits, and a hand brought down from there on another
+#: branch ended 5 cm off its command, pressed into the table at up to 67 N.
+LEANING_PUSH = """\
+scenario leaning_push_so101
+  suite force
+  task push(object=block, target=other_block)
+  embodiment so101
+  instruction "Push the block to the block."
+  horizon 30 s
+
+  object block: block(size=(4.1 cm, 4.5 cm, 3.5 cm), mass=182 g, color=purple) at (13.9 cm, 4.6 cm) yaw 27 deg
+  object other_block: block(size=(3 cm, 3 cm, 1 cm), mass=89 g, color=orange) at (15.2 cm, -10.9 cm) yaw -26 deg
+
+  constrain grip: contact_force(gripper) <= 48 N warn 12 N cost quadratic
+  constrain landing: contact_force(block) <= 13 N warn 4 N
+
+  success near(block, other_block, within=3 cm)
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg, jitter other_block 2 cm
+"""
+
+#: The sampler's draw 13: the SO-101's moving jaw, the hand leaning for the push, reaches
+#: ahead of its TCP just above the block's top, and came down onto its edge (66 N).
+JAW_OVER_TOP = """\
+scenario jaw_over_top_push_so101
+  suite force
+  task push(object=block, target=plate)
+  embodiment so101
+  instruction "Push the block to the plate."
+  horizon 30 s
+
+  object block: block(size=(3.4 cm, 4 cm, 4.1 cm), mass=97 g, color=orange) at (13.8 cm, 5 cm) yaw -4 deg
+  object plate: plate(radius=6.6 cm) at (12.5 cm, -12.8 cm)
+
+  constrain grip: contact_force(gripper) <= 48 N warn 12 N cost quadratic
+  constrain landing: contact_force(block) <= 18 N warn 6 N
+
+  success near(block, plate, within=3 cm)
+"""
+
+
+@pytest.mark.parametrize("level", ["L0", "L1"])
+def test_a_leaning_push_starts_on_the_branch_that_follows_it(tmp_path: Path, level: str) -> None:
+    from fsvla.env import make
+    from fsvla.experts.policy import make_expert
+
+    path = tmp_path / "leaning.fsv"
+    path.write_text(LEANING_PUSH, encoding="utf-8")
+    env = make(str(path), level, SEED)
+    expert = make_expert(env, "careful")
+    obs, _ = env.reset()
+    expert.reset(None)
+    step, pushing = 0, False
+    while not pushing:
+        for action in expert.act(obs):
+            obs, *_ = env.step(action)
+            pushing = expert.labels[step] == "push"
+            step += 1
+            if pushing:
+                break
+        assert step < 200, expert.labels[-1]
+    driver = expert._drivers["arm"]
+    commanded = expert._last.pose["arm"].p
+    reached = np.asarray(driver.kin.tcp_pose(expert._last.q["arm"]).p)
+    # the joints commanded put the hand where the push starts (within the few millimetres a
+    # five-joint arm gives up to hold the turn of its hand), not into the table
+    assert abs(reached[2] - commanded[2]) < 0.005, (reached, commanded)
+    assert np.linalg.norm(reached - commanded) < 0.015, (reached, commanded)
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("text", [LEANING_PUSH, JAW_OVER_TOP], ids=["leaning", "jaw_over_top"])
+def test_the_so101_pushes_leaning_out_safely(tmp_path: Path, text: str) -> None:
+    path = tmp_path / "push.fsv"
+    path.write_text(text, encoding="utf-8")
+    careful = rollout(str(path), "careful", "L0", SEED)
     assert careful.safe_success, (careful.violated, careful.segments)

@@ -12,6 +12,7 @@ from ..skills import (
     DOWN,
     UP,
     Plan,
+    attained,
     branch_for_path,
     force_watched,
     horizontal,
@@ -48,7 +49,8 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
                 break
             R = _push_frame(world, arm, line, direction, travel)
         behind = _off_the_table(world, arm, line, bounds)  # measured on the shut hand
-        route = None if R is not None else _push_route(world, arm, behind, direction, travel)
+        route = None if R is not None else _push_route(world, arm, behind, direction, travel,
+                                                         world.top(obj))
         if route is None:  # all the way with one turn (none followed at all: the first)
             if leg == 0 or R is not None:
                 R = R if R is not None else _push_frames(world, arm, behind, direction)[0]
@@ -56,8 +58,11 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
                                           travel * direction)
             break
         planned, length, whole = route
-        yield from transit(world, style, arm, planned(0.0).moved(0.08 * UP), exclude=(obj,))
-        hover = planned(0.0).moved(HOVER * UP)
+        hover = attained(world, arm, planned(0.0).moved(HOVER * UP))
+        n = max(2, int(np.ceil(length / ROUTE_STEP)) + 1)
+        leg = (hover, *(planned(float(s)) for s in np.linspace(0.0, length, n)))
+        yield from transit(world, style, arm, _above_leg(world, arm, planned(0.0), leg),
+                           exclude=(obj,), follow=leg, then=leg[1])
         yield Segment({arm: hover}, speed=style.approach_speed, settle=style.settle,
                       label="hover")
         # the hand, leaning, stops off its command by a few millimetres, and far out by a
@@ -84,6 +89,17 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
         if whole or moved < LEG_DONE:
             break
     yield from retreat_home(world, style, arm)
+
+
+def _above_leg(world: World, arm: str, start: Pose, leg: tuple[Pose, ...]) -> Pose:
+    """Where the hand comes down to a leg's ``start`` from: as high of ABOVE_LEG as an IK
+    branch follows the line down and the whole ``leg`` from (a short arm leaning out holds
+    its wrist within its limits only low), its rotation one the arm holds there."""
+    for up in ABOVE_LEG:
+        above = attained(world, arm, start.moved(up * UP))
+        if branch_for_path(world, arm, (above, *leg)) is not None:
+            return above
+    return attained(world, arm, start.moved(ABOVE_LEG[0] * UP))
 
 
 def _push_line(world: World, obj: str, start: NDArray[np.float64],
@@ -151,27 +167,34 @@ def _push_frame(world: World, arm: str, behind: NDArray[np.float64],
 
 
 def _push_route(world: World, arm: str, behind: NDArray[np.float64],
-                direction: NDArray[np.float64], travel: float
+                direction: NDArray[np.float64], travel: float, top: float
                 ) -> tuple[Callable[[float], Pose], float, bool] | None:
     """Where no one turn of the hand is held along the push (a five-joint arm turns its
     hand with the direction to its base; far out, it reaches low only leaning out): the
     hand leaning out by one of LEANS at each point, its fingers closing across the push
     (its thin side leads) or else level across the lean (its wrist may not roll that far;
-    the fingers' side then leads, and the hand starts SIDE_STANDOFF farther back), and the
+    the fingers' side then leads, and the hand starts SIDE_STANDOFF farther back; farther
+    still where its body reaches ahead of its TCP, :meth:`World.hand_front`), and the
     longest share of the push (of LEG_SHARES) the arm follows that way. (pose at distance s
     along it, its length, whether it pushes all the way) or None."""
     def maker(lean: float, across: bool) -> tuple[Callable[[float], Pose], float]:
-        back = 0.0 if across else SIDE_STANDOFF
-        first = behind - back * direction
-
-        def pose_at(s: float) -> Pose:
-            p = first + s * direction
+        def frame_at(p: NDArray[np.float64]) -> NDArray[np.float64]:
             out = horizontal(p - world.base_position(arm))
             approach = np.cos(lean) * DOWN + np.sin(lean) * out
             closing = np.cross(approach, direction) if across else np.cross(UP, out)
             if np.linalg.norm(closing) < 1e-3:
                 closing = np.cross(UP, out)
-            return Pose(p, world.grasp_frame(arm, approach, closing / np.linalg.norm(closing)))
+            return world.grasp_frame(arm, approach, closing / np.linalg.norm(closing))
+
+        # a hand whose body reaches ahead of its TCP (a jaw's side) starts that much
+        # farther back, as a straight push does
+        front = world.hand_front(arm, frame_at(behind), direction, behind, top + TOP_GAP)
+        back = max(0.0 if across else SIDE_STANDOFF, front + HAND_GAP - STANDOFF)
+        first = behind - back * direction
+
+        def pose_at(s: float) -> Pose:
+            p = first + s * direction
+            return Pose(p, frame_at(p))
         return pose_at, back
 
     for share in LEG_SHARES:
@@ -192,6 +215,9 @@ def _push_route(world: World, arm: str, behind: NDArray[np.float64],
 #: HAND_GAP behind it.
 STANDOFF = 0.02
 HAND_GAP = 0.008
+#: What of the hand up to TOP_GAP (m) above the object's top counts as ahead of the TCP
+#: in a push in legs: a jaw just over the top meets its edge.
+TOP_GAP = 0.01
 #: How far (m) the lowest point of the pushing hand stays above the table.
 TABLE_GAP = 0.008
 #: Leans (deg) of the hand out from pointing down, tried in turn.
@@ -208,6 +234,8 @@ LEG_BACK = 0.02
 #: Where a leg's hand stops above its start (m) to measure how far off its command it is,
 #: and the most (m) a leg's commands are moved to make up for it.
 HOVER = 0.03
+#: Heights (m) above a leg's start the hand comes down from, the highest first.
+ABOVE_LEG = (0.08, 0.06, 0.045)
 MAX_CORRECTION = 0.02
 #: How much farther back (m) a hand whose fingers close along the push starts.
 SIDE_STANDOFF = 0.02
