@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from itertools import product
 
 import numpy as np
 from numpy.typing import NDArray
@@ -174,10 +175,11 @@ def _push_route(world: World, arm: str, behind: NDArray[np.float64],
     hand leaning out by one of LEANS at each point, its fingers closing across the push
     (its thin side leads) or else level across the lean (its wrist may not roll that far;
     the fingers' side then leads, and the hand starts SIDE_STANDOFF farther back; farther
-    still where its body reaches ahead of its TCP, :meth:`World.hand_front`), and the
+    still where its body reaches ahead of its TCP, :meth:`World.hand_front`, unless no
+    branch follows the leg from there), and the
     longest share of the push (of LEG_SHARES) the arm follows that way. (pose at distance s
     along it, its length, whether it pushes all the way) or None."""
-    def maker(lean: float, across: bool) -> tuple[Callable[[float], Pose], float]:
+    def maker(lean: float, across: bool, clear: bool) -> tuple[Callable[[float], Pose], float]:
         def frame_at(p: NDArray[np.float64]) -> NDArray[np.float64]:
             out = horizontal(p - world.base_position(arm))
             approach = np.cos(lean) * DOWN + np.sin(lean) * out
@@ -188,7 +190,8 @@ def _push_route(world: World, arm: str, behind: NDArray[np.float64],
 
         # a hand whose body reaches ahead of its TCP (a jaw's side) starts that much
         # farther back, as a straight push does
-        front = world.hand_front(arm, frame_at(behind), direction, behind, top + TOP_GAP)
+        front = world.hand_front(arm, frame_at(behind), direction, behind, top + TOP_GAP) \
+            if clear else 0.0
         back = max(0.0 if across else SIDE_STANDOFF, front + HAND_GAP - STANDOFF)
         first = behind - back * direction
 
@@ -201,8 +204,8 @@ def _push_route(world: World, arm: str, behind: NDArray[np.float64],
         if share * travel < LEG_DONE:
             break
         for across in (True, False):
-            for lean in np.deg2rad(LEANS):
-                pose_at, back = maker(float(lean), across)
+            for lean, clear in product(np.deg2rad(LEANS), (True, False)):
+                pose_at, back = maker(float(lean), across, clear)
                 length = share * travel + back
                 n = max(2, int(np.ceil(length / ROUTE_STEP)) + 1)
                 poses = tuple(pose_at(float(s)) for s in np.linspace(0.0, length, n))
