@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from itertools import product
 
 import numpy as np
 from numpy.typing import NDArray
@@ -60,8 +59,7 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
             break
         planned, length, whole = route
         hover = attained(world, arm, planned(0.0).moved(HOVER * UP))
-        n = max(2, int(np.ceil(length / ROUTE_STEP)) + 1)
-        leg = (hover, *(planned(float(s)) for s in np.linspace(0.0, length, n)))
+        leg = (hover, *_leg_poses(planned, length))
         yield from transit(world, style, arm, _above_leg(world, arm, planned(0.0), leg),
                            exclude=(obj,), follow=leg, then=leg[1])
         yield Segment({arm: hover}, speed=style.approach_speed, settle=style.settle,
@@ -96,11 +94,19 @@ def _above_leg(world: World, arm: str, start: Pose, leg: tuple[Pose, ...]) -> Po
     """Where the hand comes down to a leg's ``start`` from: as high of ABOVE_LEG as an IK
     branch follows the line down and the whole ``leg`` from (a short arm leaning out holds
     its wrist within its limits only low), its rotation one the arm holds there."""
+    highest = None
     for up in ABOVE_LEG:
         above = attained(world, arm, start.moved(up * UP))
         if branch_for_path(world, arm, (above, *leg)) is not None:
             return above
-    return attained(world, arm, start.moved(ABOVE_LEG[0] * UP))
+        highest = highest or above
+    return highest
+
+
+def _leg_poses(pose_at: Callable[[float], Pose], length: float) -> tuple[Pose, ...]:
+    """The poses a leg goes through, every ROUTE_STEP at most, both ends included."""
+    n = max(2, int(np.ceil(length / ROUTE_STEP)) + 1)
+    return tuple(pose_at(float(s)) for s in np.linspace(0.0, length, n))
 
 
 def _push_line(world: World, obj: str, start: NDArray[np.float64],
@@ -179,7 +185,7 @@ def _push_route(world: World, arm: str, behind: NDArray[np.float64],
     branch follows the leg from there), and the
     longest share of the push (of LEG_SHARES) the arm follows that way. (pose at distance s
     along it, its length, whether it pushes all the way) or None."""
-    def maker(lean: float, across: bool, clear: bool) -> tuple[Callable[[float], Pose], float]:
+    def frames(lean: float, across: bool) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
         def frame_at(p: NDArray[np.float64]) -> NDArray[np.float64]:
             out = horizontal(p - world.base_position(arm))
             approach = np.cos(lean) * DOWN + np.sin(lean) * out
@@ -187,30 +193,27 @@ def _push_route(world: World, arm: str, behind: NDArray[np.float64],
             if np.linalg.norm(closing) < 1e-3:
                 closing = np.cross(UP, out)
             return world.grasp_frame(arm, approach, closing / np.linalg.norm(closing))
+        return frame_at
 
-        # a hand whose body reaches ahead of its TCP (a jaw's side) starts that much
-        # farther back, as a straight push does
-        front = world.hand_front(arm, frame_at(behind), direction, behind, top + TOP_GAP) \
-            if clear else 0.0
-        back = max(0.0 if across else SIDE_STANDOFF, front + HAND_GAP - STANDOFF)
+    def leg_from(back: float, frame_at) -> Callable[[float], Pose]:
         first = behind - back * direction
-
-        def pose_at(s: float) -> Pose:
-            p = first + s * direction
-            return Pose(p, frame_at(p))
-        return pose_at, back
+        return lambda s: Pose(first + s * direction, frame_at(first + s * direction))
 
     for share in LEG_SHARES:
         if share * travel < LEG_DONE:
             break
         for across in (True, False):
-            for lean, clear in product(np.deg2rad(LEANS), (True, False)):
-                pose_at, back = maker(float(lean), across, clear)
-                length = share * travel + back
-                n = max(2, int(np.ceil(length / ROUTE_STEP)) + 1)
-                poses = tuple(pose_at(float(s)) for s in np.linspace(0.0, length, n))
-                if branch_for_path(world, arm, poses) is not None:
-                    return pose_at, length, share == 1.0
+            for lean in np.deg2rad(LEANS):
+                frame_at = frames(float(lean), across)
+                plain = 0.0 if across else SIDE_STANDOFF
+                # a hand whose body reaches ahead of its TCP (a jaw's side) starts that much
+                # farther back, as a straight push does; else from the plain standoff
+                front = world.hand_front(arm, frame_at(behind), direction, behind, top + TOP_GAP)
+                for back in dict.fromkeys((max(plain, front + HAND_GAP - STANDOFF), plain)):
+                    pose_at = leg_from(back, frame_at)
+                    length = share * travel + back
+                    if branch_for_path(world, arm, _leg_poses(pose_at, length)) is not None:
+                        return pose_at, length, share == 1.0
     return None
 
 
