@@ -72,6 +72,10 @@ class GripperSpec(_Strict):
     finger_links: tuple[str, ...] = Field(min_length=1)
     home: Literal["open", "closed"] = "open"
     drive: DriveSpec = DriveSpec(stiffness=1e3, damping=1e2, force_limit=100.0)
+    pad_friction: float | None = Field(
+        None, ge=0.0, le=2.0,
+        description="static friction of the finger links' collision shapes (rubber pads: "
+                    "about 1); unset, the simulator's default material (0.3)")
 
     @model_validator(mode="after")
     def _lengths(self) -> GripperSpec:

@@ -166,6 +166,7 @@ def load_robot(scene: Any, spec: EmbodimentSpec) -> LoadedRobot:
             for arm in robot.arms:
                 arms[arm.name] = _bind_arm(articulation, robot, arm)
             _set_drives(articulation, robot)
+            _set_pad_friction(articulation, robot)
     loaded = LoadedRobot(spec=spec, articulations=articulations, arms=arms)
     loaded.reset_home()
     return loaded
@@ -314,6 +315,26 @@ def _set_drives(articulation: Any, robot: RobotSpec) -> None:
     for joint in articulation.active_joints:
         drive = plan[joint.name][0] if joint.name in plan else robot.hold_drive
         joint.set_drive_properties(drive.stiffness, drive.damping, drive.force_limit, "force")
+
+
+#: Dynamic over static friction of the finger pads' material.
+PAD_DYNAMIC_RATIO = 0.8
+
+
+def _set_pad_friction(articulation: Any, robot: RobotSpec) -> None:
+    """Give the finger links of each arm whose gripper sets ``pad_friction`` a material of
+    that static friction (dynamic PAD_DYNAMIC_RATIO of it, no bounce)."""
+    import sapien
+
+    for arm in robot.arms:
+        friction = arm.gripper.pad_friction
+        if friction is None:
+            continue
+        pad = sapien.physx.PhysxMaterial(friction, PAD_DYNAMIC_RATIO * friction, 0.0)
+        for link in articulation.links:
+            if link.name in arm.gripper.finger_links:
+                for shape in link.collision_shapes:
+                    shape.set_physical_material(pad)
 
 
 __all__ = ["LoadedArm", "LoadedRobot", "load_robot", "mount_pose"]

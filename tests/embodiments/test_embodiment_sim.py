@@ -178,3 +178,17 @@ def test_a_jaw_in_convex_pieces_has_one_shape_per_piece() -> None:
     link = next(lk for lk in robot.articulations["so101"].get_links() if lk.name == "gripper_link")
     # the link's other mesh (its servo) stays one hull
     assert len(link.collision_shapes) == len(convex_piece_files(folder)) + 1
+
+
+def test_finger_pads_get_the_friction_their_gripper_sets(loaded: tuple[object, LoadedRobot],
+                                                        ) -> None:
+    # a jaw on a hinge (SO-101, Z1) holds its load by friction alone: rubber pads; a
+    # gripper that sets none keeps the simulator's default material
+    _scene, robot = loaded
+    default = sapien.physx.get_default_material().static_friction
+    for arm in robot.arms.values():
+        want = arm.spec.gripper.pad_friction
+        for link in arm.finger_links:
+            frictions = {round(shape.physical_material.static_friction, 6)
+                         for shape in link.collision_shapes}
+            assert frictions == {round(want if want is not None else default, 6)}, link.name

@@ -143,6 +143,14 @@ def test_gripper_targets_must_match_joints() -> None:
     assert "gripper `open` has 2 values for 1 joints" in _errors(data)
 
 
+def test_pad_friction_must_be_a_friction() -> None:
+    data = _user_data()
+    data["robots"][0]["arms"][0]["gripper"]["pad_friction"] = -0.5
+    assert "pad_friction" in _errors(data)
+    data["robots"][0]["arms"][0]["gripper"]["pad_friction"] = 0.9
+    EmbodimentSpec.model_validate(data)
+
+
 def test_camera_parent_must_be_world_or_an_arm() -> None:
     data = _user_data()
     data["cameras"][0]["parent"] = "left"
