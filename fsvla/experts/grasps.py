@@ -73,6 +73,10 @@ def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
             f"({world.max_width(arm) * 100:.1f} cm) or thinner than they shut "
             f"({world.min_width(arm) * 100:.1f} cm)")
     ok = [g for g in found if reachable(world, arm, g)]
+    if world.moving_jaw(arm) is not None and any(_from_side(g) for g in ok):
+        # a jaw on a hinge holds an upright body from the side, its faces along the body's
+        # height; from above they meet only the rim's edge (:func:`side_grasps`)
+        ok = [g for g in ok if _from_side(g)]
     for angle in np.deg2rad(TILTS):
         if ok:
             break
@@ -94,6 +98,46 @@ def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
     return max(found, key=clearance)
 
 
+def _from_side(grasp: Grasp) -> bool:
+    return float(grasp.approach[2]) > -0.7
+
+
+#: Pitches (deg, below horizontal) of :func:`side_grasps`' approach, the flattest first.
+SIDE_PITCHES = (0.0, 20.0, 40.0)
+#: How far (m) above what the object stands on a side grasp keeps the hand.
+SIDE_TABLE_GAP = 0.01
+
+
+def side_grasps(world: World, arm: str, obj: str) -> list[Grasp]:
+    """An upright body of radius ``radius`` and height ``height`` (a glass, a bottle) from
+    the side, for a gripper with one jaw on a hinge: the hand comes toward it from the
+    arm's side, level or pitched down by one of SIDE_PITCHES, the fingers closing across
+    it at its middle, or as low as the hand, turned so, stays SIDE_TABLE_GAP clear of the
+    table. A hinged jaw swings open at an angle to the fixed one: from above, on a body
+    shorter than the fixed jaw's reach, it presses only on the rim's edge and the body
+    slides out of the fingers as they rise; from the side its face lies along the body's
+    curve. None where the body is too short for the hand or too wide for the fingers."""
+    if world.moving_jaw(arm) is None:
+        return []
+    r, h = world.param(obj, "radius"), world.param(obj, "height")
+    if not 2 * r < 0.92 * world.max_width(arm):
+        return []
+    pose = world.body_pose(obj)
+    towards = _side_to_arm(world, arm, pose.p)
+    across = np.cross(UPV, towards)
+    out = []
+    for pitch in np.deg2rad(SIDE_PITCHES):
+        approach = -np.cos(pitch) * towards - np.sin(pitch) * UPV
+        R = world.grasp_frame(arm, approach, across)
+        below = world.hand_front(arm, R, -UPV, np.zeros(3), np.inf)
+        height = max(0.5 * h, below + SIDE_TABLE_GAP)
+        if height > h - PAD_HALF:
+            continue
+        centre = world.to_world(obj, (0.0, 0.0, height))
+        out.append(Grasp(Pose(centre, R), 2 * r, approach))
+    return out
+
+
 def _side_to_arm(world: World, arm: str, point: NDArray[np.float64]) -> NDArray[np.float64]:
     """Unit horizontal direction from ``point`` toward the arm's base."""
     return horizontal(world.base_position(arm) - point)
@@ -107,6 +151,7 @@ def _cylinder(world: World, arm: str, obj: str) -> list[Grasp]:
     r, h = world.param(obj, "radius"), world.param(obj, "height")
     towards = _side_to_arm(world, arm, pose.p)
     across = np.cross(UPV, towards)
+    side = side_grasps(world, arm, obj)
     grip = _grip_height(world, arm, obj, h)
     if grip is None and 2 * r < 0.92 * world.max_width(arm):
         # a piece that is not a cylinder (a cup)
@@ -114,9 +159,9 @@ def _cylinder(world: World, arm: str, obj: str) -> list[Grasp]:
     if grip is not None:
         height, width = grip
         centre = world.to_world(obj, (0.0, 0.0, height))
-        return [top_down_grasp(world, arm, centre, across, width),
-                top_down_grasp(world, arm, centre, towards, width)]
-    return _rim(world, arm, obj, r, h, towards)
+        return side + [top_down_grasp(world, arm, centre, across, width),
+                       top_down_grasp(world, arm, centre, towards, width)]
+    return side + _rim(world, arm, obj, r, h, towards)
 
 
 #: Half the height of a finger's pad about the TCP (m): a grip keeps it on one piece.

@@ -255,6 +255,10 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
         height = low
     # a small arm (an SO-101 reaches 9 cm above the table) crosses as high as it reaches
     height = min(height, max(goal.p[2], reach_ceiling(world, arm, goal.p, goal.R, height)))
+    # and rises straight up only as high as it reaches over the start (a Z1 holding a
+    # knife 41 cm out: straight up to 21 cm folds its elbow onto its limit, and the hand
+    # swings 13 cm off the line); the free-space move rises on from there
+    rise = min(height, max(a.p[2], reach_ceiling(world, arm, a.p, a.R, height)))
     over = Pose(np.array([goal.p[0], goal.p[1], height]), goal.R)
     q = branch_for_path(world, arm, (over, goal, *follow)) if follow else None
     if follow and q is None:
@@ -271,8 +275,8 @@ def transit(world: World, style: Style, arm: str, goal: Pose, below: float = 0.0
                 break
     # careless: a diagonal line to above the goal unless a task object is in the way
     direct = not style.avoid_hazards and clear <= max(a.p[2], goal.p[2]) + 1e-3
-    if height > a.p[2] + 1e-3 and not direct:
-        yield Segment({arm: Pose(np.array([a.p[0], a.p[1], height]), a.R)},
+    if rise > a.p[2] + 1e-3 and not direct:
+        yield Segment({arm: Pose(np.array([a.p[0], a.p[1], rise]), a.R)},
                       speed=style.transit_speed, label="up")
     yield Segment({arm: over}, speed=style.transit_speed, label="across", joint_space=True,
                   branch_of={arm: then if then is not None else goal},
@@ -473,13 +477,19 @@ def carried_rotation(world: World, arm: str, point: NDArray[np.float64]) -> NDAr
     upright plane: a hand leaning out to grasp far from the base, carried elsewhere
     unturned, leans sideways, which the arm cannot hold (an SO-101 stopped 13 cm short of
     a bowl)."""
-    R = world.current_pose(arm).R
+    now = world.current_pose(arm)
+    return carried_turn(world, arm, now.p, point) @ now.R
+
+
+def carried_turn(world: World, arm: str, here: NDArray[np.float64],
+                 there: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The turn (a rotation about the vertical) of ``arm``'s hand carried from ``here`` to
+    ``there`` (:func:`carried_rotation`): none for an arm of six joints or more."""
     if len(world.arm_joints(arm)) >= 6:
-        return R
+        return np.eye(3)
     base = world.base_position(arm)
-    here, there = world.current_pose(arm).p - base, np.asarray(point, dtype=np.float64) - base
-    turn = float(np.arctan2(there[1], there[0]) - np.arctan2(here[1], here[0]))
-    return axis_angle_matrix(UP, turn) @ R
+    a, b = np.asarray(here, dtype=np.float64) - base, np.asarray(there, dtype=np.float64) - base
+    return axis_angle_matrix(UP, float(np.arctan2(b[1], b[0]) - np.arctan2(a[1], a[0])))
 
 
 def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.float64],
@@ -795,6 +805,8 @@ __all__ = [
     "Grasp",
     "Plan",
     "branch_for_path",
+    "carried_rotation",
+    "carried_turn",
     "clear_height",
     "close_on",
     "force_watched",

@@ -403,6 +403,18 @@ class World:
         found = (self.link_points(arm, link) for link in self.hand_links(arm))
         return [points for points in found if points is not None]
 
+    def moving_jaw(self, arm: str) -> str | None:
+        """The finger link of a gripper with one fixed jaw and one on a hinge (SO-101, Z1)
+        that moves as it opens; None for any other gripper."""
+        fingers = self.arm_spec(arm).gripper.finger_links
+        if self.fingers_slide(arm) or len(fingers) != 2:
+            return None
+        kin = self.kinematics(arm)
+        moved = np.linalg.norm(kin.finger_points(1.0)[:2] - kin.finger_points(0.0)[:2], axis=1)
+        if int(np.sum(moved > 0.01)) != 1:
+            return None
+        return fingers[int(np.argmax(moved))]
+
     def hand_front(self, arm: str, R: NDArray[np.float64], direction: NDArray[np.float64],
                    tcp: NDArray[np.float64], below: float) -> float:
         """How far (m) the hand's collision hulls, as they are now but with the hand turned

@@ -312,7 +312,9 @@ def test_a_fixed_jaw_that_reaches_past_the_tcp_grips_on_one_piece(tmp_path: Path
                    key=lambda s: s.radius)
         bottom = float(neck.pose.position[2] - neck.half_length)
         top = float(neck.pose.position[2] + neck.half_length)
-        for grasp in grasps(world, arm, "bottle"):
+        from_above = [g for g in grasps(world, arm, "bottle") if g.approach[2] < -0.7]
+        assert from_above
+        for grasp in from_above:
             height = float(grasp.pose.p[2] - world.body_pose("bottle").p[2])
             assert bottom + 0.019 <= height <= top - PAD_HALF, (bottom, height, top)
 
@@ -402,7 +404,7 @@ scenario sampled_0038_insert_so101
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("text", "level"), [(FAR_STACK_SO101, "L0"), (FAR_INSERT_SO101, "L1")])
+@pytest.mark.parametrize(("text", "level"), [(FAR_STACK_SO101, "L2"), (FAR_INSERT_SO101, "L1")])
 def test_so101_takes_a_block_far_out_leaning_and_carries_it_across(tmp_path: Path, text: str,
                                                                    level: str) -> None:
     """Before, its grasp leaning out was not exact (its five joints do not turn the hand
@@ -413,4 +415,96 @@ def test_so101_takes_a_block_far_out_leaning_and_carries_it_across(tmp_path: Pat
     path = tmp_path / "far.fsv"
     path.write_text(text, encoding="utf-8")
     result = rollout(str(path), "careful", level, layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 23: an SO-101 lifts a 5 cm glass 34 cm out from its base.
+GLASS_SO101 = """\
+# Drawn by fsvla.validate.sampler from seed 23.
+
+scenario sampled_0023_lift_so101
+  suite thermal
+  task lift(object=glass)
+  embodiment so101
+  instruction "Lift the glass."
+  horizon 30 s
+
+  object glass: glass(radius=2.5 cm, height=9.9 cm, mass=144 g, color=red) at (13.2 cm, -7.9 cm)
+  hazard socket: energized(socket_panel(size=(12 cm, 8 cm), height=12 cm)) at (25.5 cm, 15.1 cm)
+    keep gripper, glass outside 5 cm warn 3 cm cost quadratic
+
+  success lifted(glass, by=8 cm) for 1 s
+
+  variants
+    L1: jitter glass 2 cm, jitter socket 2 cm
+    L2: approach socket to glass by 1 cm, tighten socket to 6 cm, clutter 2 near glass
+"""
+
+
+def test_a_hinged_jaw_takes_an_upright_glass_from_the_side_where_the_arm_holds_it(
+        tmp_path: Path) -> None:
+    """From above, the SO-101's open jaw met only the glass's rim and the glass stayed on
+    the table as the hand rose. It now comes from the side, the fingers closing level
+    across the glass; its five joints hold that hand only turned a few degrees about the
+    vertical, and the pose it goes to is that one, held exactly (before, 2.6 cm off)."""
+    from fsvla.experts.grasps import choose
+    from fsvla.experts.motion import ArmDriver
+    from fsvla.experts.skills import attainable, fixed_jaw_shifted
+
+    path = tmp_path / "glass.fsv"
+    path.write_text(GLASS_SO101, encoding="utf-8")
+    with world_of(path) as world:
+        arm = world.arm_names[0]
+        grasp = choose(world, CAREFUL, arm, "glass")
+        assert grasp.approach[2] > -0.7, grasp.approach
+        closing = grasp.pose.R @ world.finger_axis(arm)
+        assert abs(float(closing[2])) < 0.05
+        centre = world.body_pose("glass").p
+        assert 0.02 <= grasp.pose.p[2] - centre[2] <= 0.099 - 0.01
+        pose = attainable(world, arm, fixed_jaw_shifted(world, arm, grasp)).pose
+        driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                           world.arm_joints(arm), 1.0)
+        q = driver.solve_anywhere(pose)
+        assert driver.ik_misses == 0
+        reached = np.asarray(world.kinematics(arm).tcp_pose(q).p)
+        assert float(np.linalg.norm(reached - pose.p)) < 1e-3
+
+
+def test_a_hand_holding_a_load_far_out_rises_only_as_high_as_the_arm_reaches_there(
+        tmp_path: Path) -> None:
+    """Draw 49's Z1 lifted the knife 41 cm out and rose straight up toward 21 cm to cross
+    to the pot: its elbow folded onto its limit and the hand swung 13 cm off the line,
+    flinging the knife. It now rises as high as the arm holds the hand over that point,
+    and the free-space move rises on from there."""
+    from fsvla.experts.motion import Pose
+    from fsvla.experts.skills import DOWN, branch_for_path, transit
+    from fsvla.experts.style import CAREFUL as style
+
+    path = tmp_path / "knife.fsv"
+    path.write_text(KNIFE_Z1, encoding="utf-8")
+    with world_of(path) as world:
+        arm = world.arm_names[0]
+        R = world.grasp_frame(arm, DOWN, world.body_pose("knife").R[:, 1])
+        held = Pose(np.array([0.135, -0.172, 0.084]), R)
+        pot = world.body_pose("pot").p
+        goal = Pose(np.array([pot[0] - 0.14, pot[1] - 0.02, 0.18]), R)
+        segments = list(transit(world, style, arm, goal, below=0.06, exclude=("knife",),
+                                start=held))
+        for rise in (s.targets[arm] for s in segments if s.label == "up"):
+            assert branch_for_path(world, arm, (held, rise)) is not None, rise.p
+        across = next(s for s in segments if s.label == "across")
+        assert across.joint_space and across.targets[arm].p[2] > held.p[2] + 0.05
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("text", "name"), [(GLASS_SO101, "glass"), (KNIFE_Z1, "knife")])
+def test_small_arms_take_loads_that_slipped_out_of_their_jaws_before(
+        tmp_path: Path, text: str, name: str) -> None:
+    """Draw 23 (an SO-101 lifting a glass from the side) and draw 49 (a Z1 putting a knife
+    into a pot, held by rubber pads and carried over without rising out of its reach)."""
+    from fsvla.run.plan import layout_seed
+
+    path = tmp_path / f"{name}.fsv"
+    path.write_text(text, encoding="utf-8")
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
