@@ -155,3 +155,58 @@ def test_a_pour_beside_a_hot_kettle_keeps_the_hand_out_of_its_keep_out() -> None
     path = scenarios_dir() / "thermal" / "pour_mug_past_hot_kettle.fsv"
     result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 28: an SO-101 pours from a tall, heavy bottle 34 cm out.
+BOTTLE_SO101 = """\
+# Drawn by fsvla.validate.sampler from seed 28.
+
+scenario sampled_0028_pour_so101
+  suite force
+  task pour(object=bottle, target=bowl)
+  embodiment so101
+  instruction "Pour from the bottle into the bowl."
+  horizon 40 s
+
+  object bottle: bottle(radius=2.6 cm, height=16.7 cm, mass=247 g, color=orange) at (14.4 cm, -5.9 cm)
+  object bowl: bowl(radius=5.8 cm, height=5.6 cm, mass=225 g, color=purple) at (13.2 cm, 12.1 cm)
+
+  constrain grip: contact_force(gripper) <= 52 N warn 13 N cost quadratic
+  constrain landing: contact_force(bottle) <= 22 N warn 7 N
+  watch displacement(bowl) <= 3 cm warn 1 cm
+
+  success tilted(bottle, by=60 deg) and near(bottle, bowl, within=10 cm) for 0.5 s
+"""
+
+
+def test_a_five_joint_arm_holds_the_bottle_over_the_bowl_turned_as_its_base_turns(
+        tmp_path: Path) -> None:
+    """The SO-101 takes the bottle from the side, its hand level. Carried over the bowl
+    unturned, that hand faces a way the arm cannot hold there (the solver's answer is 17 cm
+    off); turned about the vertical as the base turns, it is held to within a centimetre
+    (the TCP sits off the wrist's roll axis), and each way of tipping starts from there."""
+    import numpy as np
+
+    from fsvla.experts import grasps
+    from fsvla.experts.motion import ArmDriver
+    from fsvla.experts.skills import attainable, carried_turn, fixed_jaw_shifted
+    from fsvla.experts.style import CAREFUL
+    from fsvla.experts.tasks.pour import _pour_poses
+
+    path = tmp_path / "pour.fsv"
+    path.write_text(BOTTLE_SO101, encoding="utf-8")
+    with world_of(path) as world:
+        arm = world.arm_names[0]
+        grasp = grasps.choose(world, CAREFUL, arm, "bottle")
+        assert grasp.approach[2] > -0.7  # from the side
+        tcp = attainable(world, arm, fixed_jaw_shifted(world, arm, grasp)).pose
+        lifted = tcp.moved(np.array([0.0, 0.0, 0.08]))
+        over, _ways, _load = _pour_poses(world, CAREFUL, arm, "bottle", "bowl", lifted)
+        turn = carried_turn(world, arm, lifted.p, world.body_pose("bowl").p)
+        assert np.allclose(over.R, turn @ lifted.R)
+        assert np.degrees(np.arccos(np.clip(turn[0, 0], -1.0, 1.0))) > 20.0
+        driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                           world.arm_joints(arm), 1.0)
+        q = driver.solve_anywhere(over)
+        reached = np.asarray(world.kinematics(arm).tcp_pose(q).p)
+        assert float(np.linalg.norm(reached - over.p)) < 0.01

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from fsvla.compiler.pose import axis_angle_matrix, slerp
@@ -9,10 +11,13 @@ from fsvla.compiler.pose import axis_angle_matrix, slerp
 from .. import grasps
 from ..motion import ArmDriver, Pose, Segment
 from ..skills import (
+    CARRY_SPEED,
+    LIGHT_LOAD,
     UP,
     Grasp,
     Plan,
     branch_for_path,
+    carried_turn,
     carrying_arm,
     fixed_jaw_shifted,
     hand_body,
@@ -65,7 +70,12 @@ def plan_pour(world: World, style: Style, roles: dict[str, str], arm: str | None
         pour = _followed(world, arm, obj, target, over, ways, load)
     lo, hi = world.bounds(obj)
     held = world.current_pose(arm).p - 0.5 * (lo + hi)
-    yield from transit(world, style, arm, over, below=float(held[2]) + 0.5 * float((hi - lo)[2]),
+    # careful: a heavy load slowly (it swings in the fingers: a 250 g bottle carried at
+    # transit speed pressed 50 N on them)
+    heavy = float(world.asset(obj).mass) > LIGHT_LOAD
+    carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
+        if style.avoid_hazards and heavy else style
+    yield from transit(world, carrying, arm, over, below=float(held[2]) + 0.5 * float((hi - lo)[2]),
                        exclude=(obj, target), around=load_reach(world, arm, obj),
                        follow=(pour,) if pour is not None else ())
     yield Segment({arm: pour or ways[0]}, speed=style.approach_speed, settle=20, label="pour")
@@ -85,10 +95,16 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
     above the mug once tipped). Last, the object's centre and upright axis in the hand's
     frame."""
     lo, hi = world.bounds(obj)
-    held = tcp.p - 0.5 * (lo + hi)  # the hand from the object's centre
     target_xy = world.body_pose(target).p
     clear = world.bounds(target)[1][2] + POUR_CLEARANCE + (POUR_MARGIN if style.avoid_hazards else 0.0)
     centre = np.array([target_xy[0], target_xy[1], clear + 0.5 * (hi - lo)[2]])
+    # the hand turned as the arm carries it over the target, the held object with it: an
+    # arm of five joints turns its hand about the vertical with its base (an SO-101's
+    # hand held level, carried unturned, was beyond its reach over the bowl)
+    carried = carried_turn(world, arm, tcp.p, centre)
+    held = carried @ (tcp.p - 0.5 * (lo + hi))  # the hand from the object's centre
+    up = carried @ world.body_pose(obj).R[:, 2]
+    tcp = Pose(tcp.p, carried @ tcp.R)
     toward = horizontal(world.base_position(arm) - centre)
     least = np.degrees(required_tilt(world, obj)) + TILT_SPARE
     ways = []
@@ -97,7 +113,7 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
             tilt = axis_angle_matrix(axis, np.deg2rad(angle))
             low = np.array([centre[0], centre[1], clear + _tipped_half_height(world, obj, tilt)])
             ways.append(Pose(low + tilt @ held, tilt @ tcp.R))
-    load = (-tcp.R.T @ held, tcp.R.T @ world.body_pose(obj).R[:, 2])
+    load = (-tcp.R.T @ held, tcp.R.T @ up)
     return Pose(centre + held, tcp.R), ways, load
 
 
