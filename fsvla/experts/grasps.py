@@ -99,6 +99,7 @@ def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
 
 
 def _from_side(grasp: Grasp) -> bool:
+    """Whether ``grasp`` comes in less than about 45 deg below level."""
     return float(grasp.approach[2]) > -0.7
 
 

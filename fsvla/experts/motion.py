@@ -217,21 +217,26 @@ class ArmDriver:
         whose TCP sits off its wrist's roll axis holds a hand pointing level or pitched
         down, fingers closing level, only a few degrees off the line from its base (an
         SO-101's, 34 cm out: 6 degrees), which the rounds above close on only slowly."""
-        def miss(yaw: float) -> tuple[float, NDArray[np.float64]]:
-            R = axis_angle_matrix(np.array([0.0, 0.0, 1.0]), yaw) @ pose.R
-            answer = self.kin.inverse(tuple(pose.p), matrix_to_quat(R), seed=seed, restarts=0,
-                                      max_iterations=300)
-            q = np.asarray(answer.qpos, dtype=np.float64)
-            return float(np.linalg.norm(np.asarray(self.kin.tcp_pose(q).p) - pose.p)), R
+        misses: dict[float, float] = {}
 
-        yaws = np.linspace(-ATTAIN_YAW, ATTAIN_YAW, ATTAIN_YAWS)
-        step = float(yaws[1] - yaws[0])
-        best = min(yaws, key=lambda y: miss(float(y))[0])
+        def turned(yaw: float) -> NDArray[np.float64]:
+            return axis_angle_matrix(np.array([0.0, 0.0, 1.0]), yaw) @ pose.R
+
+        def miss(yaw: float) -> float:
+            if yaw not in misses:
+                answer = self.kin.inverse(tuple(pose.p), matrix_to_quat(turned(yaw)), seed=seed,
+                                          restarts=0, max_iterations=300)
+                q = np.asarray(answer.qpos, dtype=np.float64)
+                misses[yaw] = float(np.linalg.norm(np.asarray(self.kin.tcp_pose(q).p) - pose.p))
+            return misses[yaw]
+
+        yaws = [float(y) for y in np.linspace(-ATTAIN_YAW, ATTAIN_YAW, ATTAIN_YAWS)]
+        step = yaws[1] - yaws[0]
+        best = min(yaws, key=miss)
         while step > 1e-3:  # down to a twentieth of a degree
             step /= 2
-            best = min((best - step, best, best + step), key=lambda y: miss(float(y))[0])
-        error, R = miss(float(best))
-        return Pose(pose.p, R) if error < ATTAINED else pose
+            best = min((best - step, best, best + step), key=miss)
+        return Pose(pose.p, turned(best)) if miss(best) < ATTAINED else pose
 
     def _clip(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.clip(np.asarray(q, dtype=np.float64), self.kin.limits[:, 0], self.kin.limits[:, 1])
