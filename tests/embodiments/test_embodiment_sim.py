@@ -182,7 +182,7 @@ def test_a_jaw_in_convex_pieces_has_one_shape_per_piece() -> None:
 
 def test_finger_pads_get_the_friction_their_gripper_sets(loaded: tuple[object, LoadedRobot],
                                                         ) -> None:
-    # a jaw on a hinge (SO-101, Z1) holds its load by friction alone: rubber pads; a
+    # a jaw on a hinge (the Z1's) holds its load by friction alone: rubber pads; a
     # gripper that sets none keeps the simulator's default material
     _scene, robot = loaded
     default = sapien.physx.get_default_material().static_friction

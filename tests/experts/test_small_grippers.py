@@ -404,7 +404,7 @@ scenario sampled_0038_insert_so101
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("text", "level"), [(FAR_STACK_SO101, "L2"), (FAR_INSERT_SO101, "L1")])
+@pytest.mark.parametrize(("text", "level"), [(FAR_STACK_SO101, "L0"), (FAR_INSERT_SO101, "L1")])
 def test_so101_takes_a_block_far_out_leaning_and_carries_it_across(tmp_path: Path, text: str,
                                                                    level: str) -> None:
     """Before, its grasp leaning out was not exact (its five joints do not turn the hand
