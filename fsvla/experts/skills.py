@@ -37,6 +37,9 @@ PAD_RADIUS = 0.004
 #: edge of each pad). Measured: a 300 g mug held by its handle, its centre 3-4 cm out along
 #: the closing axis, swings loose in a carry at 8-12 N and stays put at 16 N.
 PAD_TIP_ARM = 0.01
+#: The least squeeze (N) of a careful grip by a jaw on a hinge (:func:`grip_force`),
+#: where the limits on the hand and the load leave room for it.
+HINGED_GRIP = 40.0
 #: How far (m) wider than the object a gripper with one fixed jaw reckons the object
 #: when it places that jaw beside it.
 FIXED_JAW_CLEARANCE = 0.004
@@ -118,7 +121,7 @@ def opening_for(world: World, arm: str, width: float, style: Style) -> float:
 
 
 def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
-               lever: float = 0.0, tip: float = 0.0) -> Style:
+               lever: float = 0.0, tip: float = 0.0, hinged: bool = False) -> Style:
     """The style with a grip force that holds ``obj`` (friction 0.5) and stays below half
     of the force limits on the gripper and the object, and out of their warning bands
     where that leaves enough to hold it. ``lever``: how far (m) the object's centre lies
@@ -126,14 +129,16 @@ def grip_force(world: World, obj: str, style: Style, weight_factor: float = 2.0,
     hold the object's weight × lever, or it pivots in the fingers (a bar held by its end).
     ``tip``: how far (m) the centre lies out along the closing axis; the pads' pressure must
     then hold the weight × tip, or the object swings out of the fingers in a carry (a mug
-    held by its handle)."""
+    held by its handle). ``hinged``: the grip of a jaw on a hinge, at least HINGED_GRIP
+    (its jaws, at an angle to each other, hold a block by its top edges, and a gentle
+    squeeze lets it slide out as the hand rises)."""
     if style.grip_force is None:
         return style
     mass = float(world.asset(obj).mass)
     need = weight_factor * mass * 9.81 / (2 * 0.5)
     need = max(need, weight_factor * mass * 9.81 * lever / (2 * 0.5 * PAD_RADIUS),
                weight_factor * mass * 9.81 * tip / PAD_TIP_ARM)
-    force = max(need, style.grip_force)
+    force = max(need, style.grip_force, HINGED_GRIP if hinged else 0.0)
     names = {obj, *world.gripper_entities}
     for channel in world.monitor.channels:
         if channel.metric == "contact_force" and set(channel.subjects) & names:
@@ -612,7 +617,8 @@ def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj:
     of contact and then slowly to the squeeze of its grip force; otherwise at the style's
     gripper pace. Each hand stops at its own felt squeeze while the others close on."""
     held = {arm: grip_force(world, obj, style, weight_factor, grasp_lever(world, arm, obj),
-                            grasp_tip(world, arm, obj)) for arm in widths}
+                            grasp_tip(world, arm, obj), world.moving_jaw(arm) is not None)
+            for arm in widths}
     target = {arm: opening_for(world, arm, widths[arm], held[arm]) for arm in widths}
     if not style.avoid_hazards:
         yield Segment(grippers=target, gripper_steps=style.gripper_steps,

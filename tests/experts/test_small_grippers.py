@@ -508,3 +508,57 @@ def test_small_arms_take_loads_that_slipped_out_of_their_jaws_before(
     path.write_text(text, encoding="utf-8")
     result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 74: a Z1 stacks a 190 g block 4.8 cm tall; no force limit.
+BLOCK_Z1 = """\
+# Drawn by fsvla.validate.sampler from seed 74.
+
+scenario sampled_0074_stack_z1
+  suite temporal
+  task stack(object=block, target=other_block)
+  embodiment z1
+  instruction "Stack the block on the other block."
+  horizon 30 s
+
+  object block: block(size=(2.7 cm, 3.1 cm, 4.8 cm), mass=190 g, color=blue) at (7.5 cm, 0.1 cm) yaw -30 deg
+  object other_block: block(size=(5.9 cm, 5.9 cm, 4.9 cm), mass=189 g, color=red) at (16.6 cm, -20.2 cm) yaw 19 deg
+
+  require pre: on(block, other_block) before released(block) and lifted(block, by=2 cm)
+
+  success on(block, other_block) and released(block) for 0.5 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg, jitter other_block 2 cm
+    L2: couple pre within 15 s, clutter 1 near other_block
+"""
+
+
+@pytest.mark.parametrize(("text", "obj", "least", "most"),
+                         [(BLOCK_Z1, "block", 40.0, 40.0), (KNIFE_Z1, "knife", 23.0, 23.0)])
+def test_a_hinged_jaw_squeezes_firmly_where_the_limits_leave_room(
+        tmp_path: Path, text: str, obj: str, least: float, most: float) -> None:
+    """A jaw on a hinge holds a block by its top edges; at the style's 8 N the Z1's block
+    slid out as the hand rose. It squeezes at least HINGED_GRIP, still at most half a
+    limit on the hand or the load and out of its warning band (the knife's 46 N)."""
+    from fsvla.experts.skills import grip_force
+
+    path = tmp_path / "grip.fsv"
+    path.write_text(text, encoding="utf-8")
+    with world_of(path) as world:
+        arm = world.arm_names[0]
+        hinged = world.moving_jaw(arm) is not None
+        assert hinged
+        force = grip_force(world, obj, CAREFUL, hinged=hinged).grip_force
+        assert force is not None and least <= force <= most, force
+        assert grip_force(world, obj, CAREFUL).grip_force == pytest.approx(8.0)
+
+
+@pytest.mark.slow
+def test_the_z1_stacks_a_block_it_squeezes_firmly(tmp_path: Path) -> None:
+    from fsvla.run.plan import layout_seed
+
+    path = tmp_path / "stack.fsv"
+    path.write_text(BLOCK_Z1, encoding="utf-8")
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
