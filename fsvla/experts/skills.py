@@ -475,6 +475,14 @@ def jaws_clear_of_support(world: World, arm: str, obj: str, grasp: Grasp) -> Gra
     return Grasp(Pose(p, grasp.pose.R), grasp.width, grasp.approach)
 
 
+def carrying_style(world: World, style: Style, obj: str) -> Style:
+    """The style a load is carried in: careful, one heavier than LIGHT_LOAD at no more
+    than CARRY_SPEED (faster, it shakes loose of the fingers)."""
+    if style.avoid_hazards and float(world.asset(obj).mass) > LIGHT_LOAD:
+        return replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED))
+    return style
+
+
 def carried_rotation(world: World, arm: str, point: NDArray[np.float64]) -> NDArray[np.float64]:
     """How ``arm``'s hand is turned when it carries what it holds over to ``point``: as it
     is now, or, for an arm of fewer than six joints, turned about the vertical as the arm
@@ -513,11 +521,8 @@ def place(world: World, style: Style, arm: str, obj: str, bottom: NDArray[np.flo
     offset = R @ held_offset(world, arm, obj)
     goal = Pose(bottom + offset + np.array([0.0, 0.0, style.release_height]), R)
     below = float(offset[2]) + 0.03 + (hanging(world, obj) if by_lowest else 0.0)
-    heavy = float(world.asset(obj).mass) > LIGHT_LOAD
-    carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
-        if style.avoid_hazards and heavy else style
-    yield from transit(world, carrying, arm, goal.moved(0.08 * UP), below=below, exclude=(obj,),
-                       around=load_reach(world, arm, obj))
+    yield from transit(world, carrying_style(world, style, obj), arm, goal.moved(0.08 * UP),
+                       below=below, exclude=(obj,), around=load_reach(world, arm, obj))
     # the object may have slipped in the fingers on the way: aim with where it is now
     now = R @ held_offset(world, arm, obj)
     if float(np.linalg.norm(now - offset)) > 0.05:  # dropped: nothing left to place
@@ -813,6 +818,7 @@ __all__ = [
     "branch_for_path",
     "carried_rotation",
     "carried_turn",
+    "carrying_style",
     "clear_height",
     "close_on",
     "force_watched",

@@ -66,6 +66,7 @@ class World:
         self.dt = float(dt)
         self._kinematics: dict[str, ArmModel] = {}
         self._finger_axis: dict[str, NDArray[np.float64]] = {}
+        self._moving_jaw: dict[str, str | None] = {}
         self._open_width: dict[str, float] = {}
         self._closed_gap: dict[str, float] = {}
         self._rigid: dict[str, frozenset[int]] = {}
@@ -406,6 +407,11 @@ class World:
     def moving_jaw(self, arm: str) -> str | None:
         """The finger link of a gripper with one fixed jaw and one on a hinge (SO-101, Z1)
         that moves as it opens; None for any other gripper."""
+        if arm not in self._moving_jaw:
+            self._moving_jaw[arm] = self._find_moving_jaw(arm)
+        return self._moving_jaw[arm]
+
+    def _find_moving_jaw(self, arm: str) -> str | None:
         fingers = self.arm_spec(arm).gripper.finger_links
         if self.fingers_slide(arm) or len(fingers) != 2:
             return None

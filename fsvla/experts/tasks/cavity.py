@@ -15,7 +15,6 @@ container stops it."""
 
 from __future__ import annotations
 
-from dataclasses import replace
 from itertools import product
 
 import numpy as np
@@ -25,13 +24,12 @@ from fsvla.compiler.pose import axis_angle_matrix, quat_to_matrix
 
 from ..motion import Guard, Pose, Segment
 from ..skills import (
-    CARRY_SPEED,
-    LIGHT_LOAD,
     UP,
     Plan,
     attained,
     branch_for_path,
     carried_rotation,
+    carrying_style,
     force_watched,
     free_speed,
     gentle,
@@ -252,11 +250,8 @@ def place_in_cavity(world: World, style: Style, arm: str, obj: str, target: str,
     goal = _release_followed(world, arm, obj, target, clear)
     tcp = world.current_pose(arm)
     below = float(tcp.p[2] - world.bounds(obj)[0][2]) + 0.03
-    heavy = float(world.asset(obj).mass) > LIGHT_LOAD
-    carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
-        if heavy else style
-    yield from transit(world, carrying, arm, goal.moved(0.08 * UP), below=below, exclude=(obj,),
-                       around=load_reach(world, arm, obj))
+    yield from transit(world, carrying_style(world, style, obj), arm, goal.moved(0.08 * UP),
+                       below=below, exclude=(obj,), around=load_reach(world, arm, obj))
     if not _holds(world, arm, obj):  # dropped on the way: nothing left to place
         return
     # the object may have turned in the fingers on the way: the height again, as it hangs now

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
 from fsvla.compiler.pose import axis_angle_matrix, slerp
@@ -11,14 +9,13 @@ from fsvla.compiler.pose import axis_angle_matrix, slerp
 from .. import grasps
 from ..motion import ArmDriver, Pose, Segment
 from ..skills import (
-    CARRY_SPEED,
-    LIGHT_LOAD,
     UP,
     Grasp,
     Plan,
     branch_for_path,
     carried_turn,
     carrying_arm,
+    carrying_style,
     fixed_jaw_shifted,
     hand_body,
     horizontal,
@@ -70,14 +67,11 @@ def plan_pour(world: World, style: Style, roles: dict[str, str], arm: str | None
         pour = _followed(world, arm, obj, target, over, ways, load)
     lo, hi = world.bounds(obj)
     held = world.current_pose(arm).p - 0.5 * (lo + hi)
-    # careful: a heavy load slowly (it swings in the fingers: a 250 g bottle carried at
-    # transit speed pressed 50 N on them)
-    heavy = float(world.asset(obj).mass) > LIGHT_LOAD
-    carrying = replace(style, transit_speed=min(style.transit_speed, CARRY_SPEED)) \
-        if style.avoid_hazards and heavy else style
-    yield from transit(world, carrying, arm, over, below=float(held[2]) + 0.5 * float((hi - lo)[2]),
-                       exclude=(obj, target), around=load_reach(world, arm, obj),
-                       follow=(pour,) if pour is not None else ())
+    # careful: a heavy load slowly (a 250 g bottle carried at transit speed swung in the
+    # fingers and pressed 50 N on them)
+    yield from transit(world, carrying_style(world, style, obj), arm, over,
+                       below=float(held[2]) + 0.5 * float((hi - lo)[2]), exclude=(obj, target),
+                       around=load_reach(world, arm, obj), follow=(pour,) if pour is not None else ())
     yield Segment({arm: pour or ways[0]}, speed=style.approach_speed, settle=20, label="pour")
     yield Segment({arm: over}, speed=style.approach_speed, label="unpour")
     yield from place(world, style, arm, obj, start)
