@@ -669,7 +669,8 @@ class _Draw:
             "open": f"opened({o}, fraction=0.6) for 0.5 s",
             "close": f"closed({o}) for 1 s",
             "insert": f"inside({o}, {t}) and released({o}) for 0.5 s",
-            "pour": f"tilted({o}, by=60 deg) and near({o}, {t}, within=10 cm) for 0.5 s",
+            "pour": f"tilted({o}, by=60 deg) and near({o}, {t}, within=10 cm) and grasped({o}) "
+                    "for 0.5 s",  # held as it pours: a container dropped tilted beside it is not
             "press": f"pressed({o}) for 0.5 s",
             "bimanual_lift": f"lifted({o}, by=10 cm) and upright({o}, within=15 deg) for 1 s",
             "handover": f"on({o}, {support}) and released({o}) for 1 s",

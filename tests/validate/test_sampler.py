@@ -151,3 +151,15 @@ def test_a_draw_starts_outside_every_warning_band(tmp_path: Path, seed: int, tas
                 assert [c for c, s in info["states"].items() if s != "safe"] == [], (level, sampled.text)
         finally:
             env.close()
+
+
+@given(seed=SEEDS)
+@settings(max_examples=10, deadline=None)
+def test_a_pour_succeeds_only_while_the_container_is_held(seed: int) -> None:
+    """Tipped near the target is not a pour when the container has slipped out of the hand
+    and lies on its side beside it: the success asks that it is held."""
+    sampled = sample_scenario(seed, task="pour", deep=False)
+    success = next(line.strip() for line in sampled.text.splitlines()
+                   if line.strip().startswith("success "))
+    obj = sampled.roles["object"]
+    assert f"tilted({obj}," in success and f"grasped({obj})" in success, success
