@@ -40,6 +40,8 @@ PAD_TIP_ARM = 0.01
 #: The least squeeze (N) of a careful grip by a jaw on a hinge (:func:`grip_force`),
 #: where the limits on the hand and the load leave room for it.
 HINGED_GRIP = 40.0
+#: The force (N) from the object that stops the careful hand on its way in to a grasp.
+REACH_TOUCH = 0.5
 #: How far (m) wider than the object a gripper with one fixed jaw reckons the object
 #: when it places that jaw beside it.
 FIXED_JAW_CLEARANCE = 0.004
@@ -419,9 +421,13 @@ def pick(world: World, style: Style, arm: str, obj: str, grasp: Grasp,
         top = reach_ceiling(world, arm, grasp.pose.p, grasp.pose.R, float(pre.p[2]))
         pre = Pose(np.array([pre.p[0], pre.p[1], max(grasp.pose.p[2] + 0.02, top)]), pre.R)
     yield from transit(world, style, arm, pre, exclude=(obj,), then=grasp.pose)
+    # careful: the hand stops where it touches the object on its way in, and closes
+    # there (a Z1's rubber jaw sliding 2 mm beside a glass caught on it and pressed 75 N)
+    guards = (Guard(arm, REACH_TOUCH, obj, keep_lead=0.0),) if style.avoid_hazards else ()
     yield Segment({arm: grasp.pose.moved(-0.02 * grasp.approach)}, speed=style.approach_speed,
-                  label="approach")
-    yield Segment({arm: grasp.pose}, speed=gentle(world, style, obj), label="reach")
+                  label="approach", guards=guards)
+    yield Segment({arm: grasp.pose}, speed=gentle(world, style, obj), label="reach",
+                  guards=guards)
     yield from close_on(world, style, arm, obj, grasp.width)
     lift = min(style.lift_height, max(0.02, reach_ceiling(
         world, arm, grasp.pose.p, grasp.pose.R, grasp.pose.p[2] + style.lift_height)

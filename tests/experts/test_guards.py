@@ -163,3 +163,40 @@ def test_both_hands_close_on_the_pot_together(tmp_path, x):
     result = rollout(_write(tmp_path, "pot", POT.format(x=x)), "careful")
     assert result.safe_success, result.summary()
     assert result.segments.count("close") == 1, result.segments
+
+
+@pytest.mark.parametrize(("style", "stops"), [("careful", True), ("careless", False)])
+def test_the_careful_hand_stops_where_it_touches_the_object_on_its_way_in(tmp_path, style,
+                                                                         stops):
+    """A grasp aimed 3 cm off the block's middle brings a finger down onto its top: the
+    careful hand stops there, as a wrist sensor ends a move until contact; the careless
+    one drives on into it (320 N)."""
+    from fsvla.env import make
+    from fsvla.experts import grasps
+    from fsvla.experts.policy import make_expert
+    from fsvla.experts.skills import Grasp, pick
+    from fsvla.experts.style import STYLES
+    from fsvla.experts.world import World
+
+    env = make(_write(tmp_path, "press_block", PRESS.format(x="15 cm", y="5 cm", limit=200,
+                                                           warn=10)))
+    observation, _ = env.reset()
+    expert = make_expert(env, style)
+    expert.reset(None)
+    world = World.of_env(env)
+    chosen = grasps.choose(world, STYLES[style], "arm", "button")
+    across = chosen.pose.R @ world.finger_axis("arm")
+    aimed = Grasp(chosen.pose.moved(0.03 * across), chosen.width, chosen.approach)
+    expert._plan = pick(world, STYLES[style], "arm", "button", aimed)
+    felt, step = 0.0, 0
+    while step < 400 and not set(expert.labels[step:]) & {"preclose", "close"}:
+        for action in expert.act(observation):
+            label = expert.labels[step]
+            observation, *_ = env.step(action)
+            step += 1
+            if label in ("approach", "reach"):
+                felt = max(felt, world.hand_force("arm", "button"))
+    env.close()
+    assert ("stopped by force" in expert.log) is stops, expert.log
+    # the first touch itself is felt (22 N: a stiff arm meets the block within a step)
+    assert (felt < 50.0) is stops, f"{style}: the hand pressed {felt:.1f} N on its way in"
