@@ -24,6 +24,15 @@ from .skills import (
 from .style import Style
 from .world import HAND_DEPTH, World, box_distance
 
+#: The share of its full opening a gripper's fingers may be asked to span around what they
+#: grasp: the 8 % left over is what they clear it by as they come down around it.
+OPENING_SHARE = 0.92
+
+
+def fits(world: World, arm: str, width: float) -> bool:
+    """Whether ``width`` (m) across is narrower than OPENING_SHARE of ``arm``'s opening."""
+    return width < OPENING_SHARE * world.max_width(arm)
+
 
 def grasps(world: World, arm: str, obj: str) -> list[Grasp]:
     kind = world.kind(obj)
@@ -121,7 +130,7 @@ def side_grasps(world: World, arm: str, obj: str) -> list[Grasp]:
     if world.moving_jaw(arm) is None:
         return []
     r, h = world.param(obj, "radius"), world.param(obj, "height")
-    if not 2 * r < 0.92 * world.max_width(arm):
+    if not fits(world, arm, 2 * r):
         return []
     pose = world.body_pose(obj)
     towards = _side_to_arm(world, arm, pose.p)
@@ -154,7 +163,7 @@ def _cylinder(world: World, arm: str, obj: str) -> list[Grasp]:
     across = np.cross(UPV, towards)
     side = side_grasps(world, arm, obj)
     grip = _grip_height(world, arm, obj, h)
-    if grip is None and 2 * r < 0.92 * world.max_width(arm):
+    if grip is None and fits(world, arm, 2 * r):
         # a piece that is not a cylinder (a cup)
         grip = max(0.3 * h, h - world.hand_depth(arm)), 2 * r
     if grip is not None:
@@ -183,7 +192,7 @@ def _grip_height(world: World, arm: str, obj: str, h: float) -> tuple[float, flo
         arm, world.grasp_frame(arm, DOWN, np.array([1.0, 0.0, 0.0])), DOWN, np.zeros(3), np.inf))
     found: list[tuple[float, float, float]] = []
     for shape in world.asset(obj).collision:
-        if shape.type != "cylinder" or 2 * shape.radius >= 0.92 * world.max_width(arm) \
+        if shape.type != "cylinder" or not fits(world, arm, 2 * shape.radius) \
                 or 2 * shape.radius < world.min_width(arm) \
                 or quat_to_matrix(shape.pose.quaternion)[2, 2] < 0.99:
             continue
@@ -210,7 +219,7 @@ def _mug(world: World, arm: str, obj: str) -> list[Grasp]:
     side = _handle_side(world, obj)
     inner = float(high.pose.position[0] - side * high.half_size[0])
     outer = float(grip.pose.position[0] + side * grip.half_size[0])
-    if abs(outer - inner) >= 0.92 * world.max_width(arm):  # a kettle's, in Baxter's hand
+    if not fits(world, arm, abs(outer - inner)):  # a kettle's, in Baxter's hand
         return _cylinder(world, arm, obj)
     z = float(high.pose.position[2])
     centre = world.to_world(obj, (0.5 * (inner + outer), 0.0, z))
@@ -256,7 +265,7 @@ def _block(world: World, arm: str, obj: str) -> list[Grasp]:
     out = []
     for axis in (0, 1):
         closing = pose.R[:, axis]
-        if world.min_width(arm) <= 2 * half[axis] < 0.92 * world.max_width(arm):
+        if world.min_width(arm) <= 2 * half[axis] and fits(world, arm, 2 * half[axis]):
             g = top_down_grasp(world, arm, centre + np.array([0.0, 0.0, 0.3 * half[2]]), closing,
                                2 * half[axis])
             out.append((abs(float(closing @ towards)), g))
