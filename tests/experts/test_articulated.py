@@ -418,3 +418,26 @@ def test_careful_baxter_pulls_a_drawer_again_where_the_first_pull_fell_short(
     for level in ("L0", "L1", "L2"):
         result = rollout(str(path), "careful", level, layout_seed(0, 0))
         assert result.safe_success, f"{level}: {result.summary()}"
+
+
+OPEN_DOOR = """\
+scenario open_microwave
+  suite force
+  task open(object=oven)
+  embodiment panda
+  instruction "Open the microwave."
+  horizon 30 s
+
+  object oven: microwave() at (20 cm, 5 cm)
+
+  success opened(oven, fraction=0.6) for 0.5 s
+"""
+
+
+def test_careful_panda_swings_a_door_open_without_losing_its_handle(tmp_path: Path) -> None:
+    """The pads hold a door's handle by friction along the pull: at an 8 N squeeze the
+    Panda's fingers slid off the microwave's handle as the door passed 55° (it stopped
+    there, short of the 60 % asked); the door pinch squeezes 24 N."""
+    result = rollout(str(_write(tmp_path, OPEN_DOOR)), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+    assert "swing door" in result.segments

@@ -431,6 +431,12 @@ def finger_box(world: World, arm: str) -> tuple[float, float]:
     return reach or 0.01, thick or 0.011
 
 
+#: The careful squeeze (N) on a door's handle that the door is swung by: the pads hold
+#: the handle by friction along the pull (at the style's 8 N a Panda's fingers slid off a
+#: microwave's handle as the door passed 55°, and it stopped there).
+DOOR_PINCH = 24.0
+
+
 def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
     """Pinch a door's handle across its width, the hand pitched down toward the door, and
     turn the door with it about its hinge to ``angle`` (rad); let go and back away."""
@@ -488,25 +494,27 @@ def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps, label="open")
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to handle")
-    yield from pinch(world, style, arm, body, width)
+    yield from pinch(world, style, arm, body, width, DOOR_PINCH)
     yield from _sweep(world, style, arm, at, h.now, angle, "swing door")
     yield Segment({}, settle=style.settle, label="hold door")
     yield from _let_go(world, style, arm, opening, 0.06)
 
 
-def pinch_force(world: World, style: Style, body: str) -> float:
-    """The careful squeeze on a part of ``body``: the style's grip force, at most half of a
-    contact-force limit on the hand or the body and out of its warning band, at least 2 N."""
-    force = float(style.grip_force or 0.0)
+def pinch_force(world: World, style: Style, body: str, wanted: float | None = None) -> float:
+    """The careful squeeze on a part of ``body``: ``wanted`` (default: the style's grip
+    force), at most half of a contact-force limit on the hand or the body and out of its
+    warning band, at least 2 N."""
+    force = float(style.grip_force or 0.0) if wanted is None else wanted
     allowed = world.force_allowance(body, *world.gripper_entities)
     return max(force if allowed is None else min(force, allowed), 2.0)
 
 
-def pinch(world: World, style: Style, arm: str, body: str, width: float) -> Plan:
+def pinch(world: World, style: Style, arm: str, body: str, width: float,
+          wanted: float | None = None) -> Plan:
     """Close the fingers on a part ``width`` across: careful, quickly to just short of it,
-    then slowly with the hand's force guarded at :func:`pinch_force`, closing on by small
-    steps until the squeeze is felt; careless, shut at once."""
-    force = pinch_force(world, style, body)
+    then slowly with the hand's force guarded at :func:`pinch_force` (of ``wanted``),
+    closing on by small steps until the squeeze is felt; careless, shut at once."""
+    force = pinch_force(world, style, body, wanted)
     target = opening_for(world, arm, width, replace(style, grip_force=force)
                          if style.grip_force is not None else style)
     if not style.avoid_hazards:
