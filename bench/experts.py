@@ -27,9 +27,12 @@ neither faulted nor crossed anything, ``success never held`` — with ``--explai
 first conjunct of ``success`` that never held, from a replay of the episode
 (:func:`fsvla.validate.conjuncts.replay_success`, one more episode's simulation each).
 Issue 18's bars: >= 80 % careful safe success at L0, >= 60 % at L1-L2, >= 50 % careless
-unsafe.
+unsafe. Draws whose failures were studied while the experts were written are not a fair
+measure of what they do on a new scenario: read the rates on a seed range nobody has
+looked at as well (``--first 1000``, say).
 
     python bench/experts.py --random 22 --levels L0 --seeds 1 --workers 1 [--explain]
+    python bench/experts.py --random 132 --first 1000 --seeds 1   # fresh draws
 
 **The validate table** (issue: the 66 scenarios). With ``--validate`` the bench runs
 ``fsvla validate`` (careful, careless and hold-still, resumable, into ``--out``) and
