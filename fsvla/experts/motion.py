@@ -90,6 +90,8 @@ class Guard:
     #: fingers (a grip), so that the hand keeps pushing with about that fraction of the
     #: force it felt (a press must go on pressing; a grip must go on holding)
     keep_lead: float = 0.5
+    #: read the fingers only (a grip's squeeze), not the whole hand (a move's touch)
+    fingers: bool = False
 
 
 @dataclass

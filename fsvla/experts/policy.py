@@ -133,7 +133,7 @@ class ExpertPolicy:
             if steps:
                 break
             felt = [g for g in step.guards
-                    if self._world.hand_force(g.arm, g.other) >= g.force]
+                    if self._world.hand_force(g.arm, g.other, g.fingers) >= g.force]
             if felt:
                 self._stop_guarded(felt)
                 continue

@@ -662,7 +662,8 @@ def close_hands_on(world: World, style: Style, widths: Mapping[str, float], obj:
     # a stiff finger drive stopped by the guard may still squeeze well past the force
     # (it meets the object within one control step): open by a little until it is eased
     for _ in range(EASE_STEPS):
-        tight = [arm for arm in widths if world.hand_force(arm, obj) > EASE_ABOVE * force[arm]]
+        tight = [arm for arm in widths
+                 if world.hand_force(arm, obj, fingers=True) > EASE_ABOVE * force[arm]]
         if not tight:
             break
         yield Segment(grippers={arm: min(1.0, world.gripper_opening(arm) + EASE_STEP)
@@ -683,7 +684,7 @@ def creep_shut(world: World, style: Style, obj: str, start: Mapping[str, float],
     for _ in range(CREEP_STEPS):
         moving = {}
         for arm, now in opening.items():
-            if now <= target[arm] or world.hand_force(arm, obj) >= guard[arm].force:
+            if now <= target[arm] or world.hand_force(arm, obj, fingers=True) >= guard[arm].force:
                 continue
             gap = world.grip_gap(arm, obj)
             rate = SLOW_CLOSE if gap is None or gap >= CREEP_GAP else \
@@ -712,7 +713,7 @@ def squeeze_until_felt(world: World, style: Style, force: Mapping[str, float], o
     step = {arm: SQUEEZE_STEP if slide[arm] else EASE_STEP for arm in force}
     for _ in range(max(SQUEEZE_STEPS if slide[arm] else 3 * SQUEEZE_STEPS for arm in force)):
         loose = [arm for arm in force
-                 if world.hand_force(arm, obj) < 0.8 * force[arm] and goal[arm] > 0.0]
+                 if world.hand_force(arm, obj, fingers=True) < 0.8 * force[arm] and goal[arm] > 0.0]
         if not loose:
             break
         for arm in loose:
@@ -732,7 +733,7 @@ def grip_guard(world: World, arm: str, force: float, obj: str) -> Guard:
     it. A jaw on a soft drive swings on past the felt force: it holds half its lead;
     sliding fingers hold their command (their squeeze is what holds a heavy load)."""
     return Guard(arm, force, obj, hold_measured=False,
-                 keep_lead=1.0 if world.fingers_slide(arm) else 0.5)
+                 keep_lead=1.0 if world.fingers_slide(arm) else 0.5, fingers=True)
 
 
 def load_reach(world: World, arm: str, obj: str) -> float:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.monitor import MonitorSpec, RobotEntity
+from fsvla.compiler.monitor import MonitorSpec, lower_arms
 from fsvla.compiler.pose import AXES, quat_to_matrix, rotation_angle, rotation_between
 from fsvla.compiler.scene import SceneSpec
 from fsvla.dsl.models import Scenario
@@ -71,6 +71,7 @@ class World:
         self._closed_gap: dict[str, float] = {}
         self._rigid: dict[str, frozenset[int]] = {}
         self._hand_depth: dict[str, float] = {}
+        self._hand_links: dict[str, tuple[str, ...]] = {}
 
     @classmethod
     def of_env(cls, env: Any) -> World:
@@ -381,13 +382,14 @@ class World:
         return ("gripper", *[f"{arm}_gripper" for arm in self.arm_names])
 
     def hand_links(self, arm: str) -> tuple[str, ...]:
-        """The robot links of ``arm``'s hand and fingers (the monitor's gripper entity)."""
-        name = "gripper" if len(self.arm_names) == 1 else f"{arm}_gripper"
-        for entity in self.monitor.entities:
-            if isinstance(entity, RobotEntity) and entity.name == name:
-                return tuple(link.link for link in entity.links)
-        spec = self.arm_spec(arm)
-        return (spec.ee_link, *spec.gripper.finger_links)
+        """The robot links of ``arm``'s hand and fingers: its URDF's subtree from the hand,
+        what the monitor's `gripper` entities are made of, whether or not the scenario
+        names one (without one, the palm was left out, and a Panda's palm pressing 600 N
+        on a door went unfelt)."""
+        if arm not in self._hand_links:
+            self._hand_links.update((a.name, tuple(a.gripper_links))
+                                    for a in lower_arms(self.scene.embodiment))
+        return self._hand_links[arm]
 
     def hand_reach(self, arm: str) -> float:
         """How far (m) the hand's collision hulls reach past the TCP along its approach
@@ -448,10 +450,13 @@ class World:
         pose = self.state.robot_link_pose(arm, link)
         return vertices @ quat_to_matrix(pose.q).T + np.asarray(pose.p)
 
-    def hand_force(self, arm: str, other: str | None = None) -> float:
+    def hand_force(self, arm: str, other: str | None = None, fingers: bool = False) -> float:
         """What a force sensor in ``arm``'s hand reads now (N): the largest net contact
-        force on one of its links, from the body ``other`` when given."""
-        return self.state.contact_force(arm, self.hand_links(arm), other)
+        force on one of its links, from the body ``other`` when given; ``fingers``: on one
+        of its fingers only, what a grip squeezes with (a palm resting on a door is no
+        squeeze on its handle)."""
+        links = self.arm_spec(arm).gripper.finger_links if fingers else self.hand_links(arm)
+        return self.state.contact_force(arm, links, other)
 
     def current_pose(self, arm: str) -> Pose:
         pose = self.state.tcp_pose(arm)

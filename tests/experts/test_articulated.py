@@ -441,3 +441,24 @@ def test_careful_panda_swings_a_door_open_without_losing_its_handle(tmp_path: Pa
     result = rollout(str(_write(tmp_path, OPEN_DOOR)), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
     assert "swing door" in result.segments
+
+
+@pytest.mark.parametrize("limit", ["", "  constrain grip: contact_force(gripper) <= 500 N warn 10 N\n"])
+def test_naming_the_gripper_in_a_limit_does_not_change_what_the_hand_feels(
+        tmp_path: Path, limit: str) -> None:
+    """The hand's sensor reads its whole hand, palm too, whether or not the scenario names
+    `gripper` (the palm was left out without it), and a grip's squeeze reads the fingers
+    only: with a 500 N limit that never binds, the palm resting on the microwave's door
+    read as the squeeze on its handle, and the fingers stopped short of it."""
+    from fsvla.env import make
+
+    text = OPEN_DOOR.replace("  success opened", limit + "\n  success opened" if limit else
+                             "  success opened")
+    path = _write(tmp_path, text)
+    env = make(str(path), "L0", 0)
+    env.reset()
+    world = World.of_env(env)
+    assert "panda_hand" in world.hand_links("arm")
+    env.close()
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()

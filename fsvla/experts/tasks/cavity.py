@@ -212,7 +212,7 @@ def _holds(world: World, arm: str, obj: str) -> bool:
     squeeze felt (a grasp that missed leaves the hand just above the object)."""
     lo, hi = world.bounds(obj)
     return (box_distance(world.current_pose(arm).p, lo, hi) <= HELD_WITHIN
-            and world.hand_force(arm, obj) > 0.0)
+            and world.hand_force(arm, obj, fingers=True) > 0.0)
 
 
 #: Leans (rad) of the hand out from the arm's base tried in turn where the arm follows

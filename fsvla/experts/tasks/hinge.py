@@ -329,7 +329,7 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to knob")
     yield from pinch(world, style, arm, body, width)
-    if style.avoid_hazards and world.hand_force(arm, body) < FELT:
+    if style.avoid_hazards and world.hand_force(arm, body, fingers=True) < FELT:
         if missed is not None:
             yield from _let_go(world, style, arm, opening, 0.05)
             yield from missed()
@@ -540,7 +540,7 @@ def squeeze_on(world: World, style: Style, arm: str, body: str, force: float,
     guard = grip_guard(world, arm, force, body)
     goal = world.gripper_opening(arm)
     for _ in range(SQUEEZE_STEPS):
-        if world.hand_force(arm, body) >= 0.8 * force or goal <= 0.0:
+        if world.hand_force(arm, body, fingers=True) >= 0.8 * force or goal <= 0.0:
             break
         goal = max(0.0, goal - step)
         yield Segment(grippers={arm: goal}, gripper_steps=2, settle=2, guards=(guard,),
