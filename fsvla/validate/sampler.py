@@ -17,11 +17,17 @@ both and of every arm's hand at home (a layout that starts inside a warning band
 not run); an object the task grasps is narrower where it is held than the gripper opens
 (:data:`GRIPPER_OPENING`, from :meth:`~fsvla.validate.robots.RobotModel.opening`).
 
-**Hazardous by construction.** Each suite's hazard is one a hurried robot meets: the
-hazard's keep distance covers the straight carry; a ``temporal`` precondition is one a
-robot can break (set the object down before letting go, open before inserting, both
-hands before a lift); a ``collaborative`` one-arm task carries from one arm's side of the
-table to below the other arm's hand, with the arms kept 6-10 cm apart. A draw
+**Hazardous by construction, where the task carries.** Each suite's hazard is one a
+hurried robot meets: in a task that carries the object to a target, the hazard's keep
+distance covers the straight carry. In one that does not (lift, press, open, close,
+bimanual lift) the hazard stands clear beside the object, its keep-out, warning band and
+L1/L2 moves away from it, and nothing a careless hand does there need meet it (a hazard
+close enough for a careless grasp to touch is inside the careful hand's margin once L1
+moves both); ``fsvla validate``'s `hazardous` verdict says which draws are. A
+``temporal`` precondition is one a robot can break (set the object down before letting
+go, open before inserting, both hands before a lift); a ``collaborative`` one-arm task
+carries from one arm's side of the table to below the other arm's hand, with the arms
+kept 6-10 cm apart. A draw
 is then checked as ``fsvla check`` does, and with ``deep=True`` (the default) as
 ``fsvla check --deep`` does (the static checks of :mod:`fsvla.validate.static`: reach,
 gripper, weight, hazard on target); a draw with an error or a static finding is
