@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from fsvla.compiler.monitor import MonitorSpec, lower_arms
+from fsvla.compiler.monitor import MonitorSpec
 from fsvla.compiler.pose import AXES, quat_to_matrix, rotation_angle, rotation_between
 from fsvla.compiler.scene import SceneSpec
 from fsvla.dsl.models import Scenario
@@ -71,7 +71,6 @@ class World:
         self._closed_gap: dict[str, float] = {}
         self._rigid: dict[str, frozenset[int]] = {}
         self._hand_depth: dict[str, float] = {}
-        self._hand_links: dict[str, tuple[str, ...]] = {}
 
     @classmethod
     def of_env(cls, env: Any) -> World:
@@ -382,14 +381,11 @@ class World:
         return ("gripper", *[f"{arm}_gripper" for arm in self.arm_names])
 
     def hand_links(self, arm: str) -> tuple[str, ...]:
-        """The robot links of ``arm``'s hand and fingers: its URDF's subtree from the hand,
-        what the monitor's `gripper` entities are made of, whether or not the scenario
-        names one (without one, the palm was left out, and a Panda's palm pressing 600 N
-        on a door went unfelt)."""
-        if arm not in self._hand_links:
-            self._hand_links.update((a.name, tuple(a.gripper_links))
-                                    for a in lower_arms(self.scene.embodiment))
-        return self._hand_links[arm]
+        """The robot links of ``arm``'s hand and fingers: its URDF's subtree from the hand as
+        the monitor spec lowered it (``MonitorSpec.arms``), what the monitor's `gripper`
+        entities are made of, whether or not the scenario names one (without one, the palm
+        was left out, and a Panda's palm pressing 600 N on a door went unfelt)."""
+        return next(tuple(a.gripper_links) for a in self.monitor.arms if a.name == arm)
 
     def hand_reach(self, arm: str) -> float:
         """How far (m) the hand's collision hulls reach past the TCP along its approach
