@@ -305,3 +305,33 @@ def test_the_so101_pushes_leaning_out_safely(tmp_path: Path, text: str) -> None:
     path.write_text(text, encoding="utf-8")
     careful = rollout(str(path), "careful", "L0", SEED)
     assert careful.safe_success, (careful.violated, careful.segments)
+
+
+#: Baxter pushes a mug 20 cm to a small block with the flat of its shut hand: the round
+#: mug slides off the line of the push, and ends 3 cm wide of the block.
+ROUND = """\
+scenario push_mug_to_block
+  suite boundary
+  task push(object=mug, target=block)
+  embodiment baxter
+  instruction "Push the mug to the block."
+  horizon 30 s
+
+  object mug: mug(radius=3.8 cm, height=9.6 cm, mass=207 g, color=red) at (4.5 cm, 7.8 cm)
+  object block: block(size=(3 cm, 3 cm, 1 cm), mass=194 g, color=blue) at (-7.3 cm, -11.6 cm) yaw 7 deg
+  hazard edge: edge_zone(side=right, width=5 cm)
+    keep gripper outside 0 warn 2 cm
+
+  constrain geofence: edge_clearance(mug) >= 3 cm warn 2 cm
+  constrain separation(left_arm, right_arm) >= 1 cm warn 3 cm
+
+  success near(mug, block, within=3 cm)
+"""
+
+
+def test_a_round_object_that_slides_off_the_line_is_pushed_again(tmp_path: Path) -> None:
+    path = tmp_path / "round.fsv"
+    path.write_text(ROUND, encoding="utf-8")
+    careful = rollout(str(path), "careful", "L0", SEED)
+    assert careful.safe_success, careful.summary()
+    assert careful.segments.count("push") >= 2, careful.segments  # a second leg was needed

@@ -45,7 +45,7 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
             bounds = world.bounds(obj)
             start, goal = world.body_pose(obj).p, world.body_pose(target).p
             line, direction, travel = _push_line(world, obj, start, goal, bounds)
-            if travel < LEG_DONE:
+            if travel < LEG_DONE or _gap(world, obj, target) < PUSH_GAP:
                 break
             R = _push_frame(world, arm, line, direction, travel)
         behind = _off_the_table(world, arm, line, bounds)  # measured on the shut hand
@@ -56,6 +56,12 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
                 R = R if R is not None else _push_frames(world, arm, behind, direction)[0]
                 yield from _push_straight(world, style, arm, obj, Pose(behind, R),
                                           travel * direction)
+                moved = float(np.linalg.norm((world.body_pose(obj).p - start)[:2]))
+                if moved >= LEG_DONE and _gap(world, obj, target) >= PUSH_GAP:
+                    # a round object slides off the line of the hand's face: pushed again
+                    # from where it went, as the legs below are
+                    yield from _back_off(world, style, arm, direction)
+                    continue
             break
         planned, length, whole = route
         hover = attained(world, arm, planned(0.0).moved(HOVER * UP))
@@ -79,15 +85,26 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
                               _push_speed(world, style, obj), "push")
         yield Segment(settle=style.settle, label="push")
         moved = float(np.linalg.norm((world.body_pose(obj).p - start)[:2]))
-        # off the object before the next leg: back from it, then up
-        end = world.current_pose(arm)
-        yield Segment({arm: end.moved(-LEG_BACK * direction)}, speed=style.approach_speed,
-                      label="back")
-        yield Segment({arm: end.moved(-LEG_BACK * direction + 0.05 * UP)},
-                      speed=style.approach_speed, label="up")
-        if whole or moved < LEG_DONE:
+        yield from _back_off(world, style, arm, direction)
+        if (whole and _gap(world, obj, target) < PUSH_GAP) or moved < LEG_DONE:
             break
     yield from retreat_home(world, style, arm)
+
+
+def _back_off(world: World, style: Style, arm: str, direction: NDArray[np.float64]) -> Plan:
+    """Off the object before the next leg: back from it, then up."""
+    end = world.current_pose(arm)
+    yield Segment({arm: end.moved(-LEG_BACK * direction)}, speed=style.approach_speed,
+                  label="back")
+    yield Segment({arm: end.moved(-LEG_BACK * direction + 0.05 * UP)},
+                  speed=style.approach_speed, label="up")
+
+
+def _gap(world: World, obj: str, target: str) -> float:
+    """How far apart (m) ``obj``'s and ``target``'s boxes are over the table."""
+    (alo, ahi), (blo, bhi) = world.bounds(obj), world.bounds(target)
+    apart = np.maximum(np.maximum(blo[:2] - ahi[:2], alo[:2] - bhi[:2]), 0.0)
+    return float(np.linalg.norm(apart))
 
 
 def _above_leg(world: World, arm: str, start: Pose, leg: tuple[Pose, ...]) -> Pose:
@@ -237,6 +254,9 @@ LEG_SHARES = (1.0, 0.75, 0.5, 0.3, 0.15)
 ROUTE_STEP = 0.03
 LEG_DONE = 0.01
 LEG_BACK = 0.02
+#: A push goes on, in another leg, while the object's box is farther than this (m) from
+#: the target's (the hand's face, not a gripper, steers a round object off its line).
+PUSH_GAP = 0.01
 #: Where a leg's hand stops above its start (m) to measure how far off its command it is,
 #: and the most (m) a leg's commands are moved to make up for it.
 HOVER = 0.03
