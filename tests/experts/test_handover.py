@@ -253,3 +253,36 @@ def test_a_bar_the_grip_cannot_hold_level_is_handed_over_and_laid_down(
     assert result.safe_success, result.summary()
     if text is TILTED_BAR:
         assert "lay down" in result.segments
+
+
+#: Two Pandas hand a 20 cm bar over; a requirement asks the hands to come within 15 cm of
+#: each other before the right one holds it. Taken by its two ends, they stay 17 cm apart.
+ALIGNED = """\
+scenario hand_over_aligned
+  suite temporal
+  task handover(object=block)
+  embodiment dual_panda
+  instruction "Hand the block from the left arm to the right arm and set it on the plate."
+  horizon 40 s
+
+  object block: block(size=(3 cm, 19.8 cm, 3 cm), mass=119 g, color=purple) at (-22.6 cm, 15.3 cm) yaw 90 deg
+  object plate: plate(radius=8 cm) at (-7.7 cm, -18.5 cm)
+
+  require pre: aligned(left_gripper, right_gripper, within=15 cm) before grasped(block, right)
+  constrain separation(left_arm, right_arm) >= 1 cm warn 3 cm
+
+  success on(block, plate) and released(block) for 1 s
+"""
+
+
+def test_the_taker_takes_a_long_bar_near_enough_to_keep_a_required_alignment(
+        tmp_path: Path) -> None:
+    """The taker takes the bar nearer the giver's hand, even where it hangs tilted in the
+    giver's fingers (a Panda's drive squeezes a 3 cm bar at 15 N at most: not enough to
+    hold it level by its end). That it then also lands on the plate depends on how far it
+    swings in the taker's fingers: not asserted."""
+    path = tmp_path / "aligned.fsv"
+    path.write_text(ALIGNED, encoding="utf-8")
+    careful = rollout(str(path), "careful", "L0", SEED)
+    assert not careful.violation, careful.summary()
+    assert careful.min_margin["pre"] > 0

@@ -94,6 +94,11 @@ class ArmGap:
                     self._geometry[(arm, i)] = pieces
 
     @property
+    def asks_aligned(self) -> bool:
+        """Whether a requirement asks the two arms' parts to come within a distance."""
+        return bool(self._aligned)
+
+    @property
     def watched(self) -> bool:
         """Whether a separation limit, or a required alignment, watches the two arms."""
         return bool(self._checks or self._aligned)

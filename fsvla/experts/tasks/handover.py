@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import product
 
 import numpy as np
 from numpy.typing import NDArray
@@ -281,6 +282,9 @@ def _exchange_margin(world: World, gap: ArmGap, giver: str, taker: str, q_giver,
     return margin if gap.aligned(q_giver, q_take) else margin - UNALIGNED
 
 
+#: How much nearer the giver's hand (m) than its usual place the careful taker may take
+#: a long object where a requirement asks the hands to come together (:func:`_take_outs`).
+TAKE_NEARER = (0.02, 0.04, 0.06)
 #: How far apart (m) along the object the careful hands hold it at least while it
 #: changes hands (a Panda hand's body is 6 cm thick along it).
 HANDS_APART = 0.08
@@ -338,18 +342,28 @@ def _plan_exchange(world: World, style: Style, obj: str, giver: str,
                 q_giver = branch_for_path(world, giver, (held,))
                 if q_giver is None:
                     continue
-                for tilt in TILTS:
-                    grasp = _taker_grasp(world, taker, bar, middle, toward, take_at[inset],
-                                         tilt)
+                for out, tilt in product(_take_outs(bar, inset, take_at[inset], gap), TILTS):
+                    grasp = _taker_grasp(world, taker, bar, middle, toward, out, tilt)
                     for above in ABOVE:
                         margin = _exchange_margin(world, gap, giver, taker, q_giver, grasp,
                                                   above)
                         if margin > best_margin:
-                            best = (e, _Exchange(middle, inset, take_at[inset], above, tilt))
+                            best = (e, _Exchange(middle, inset, out, above, tilt))
                             best_margin = margin
                         if margin >= GAP_SLACK:
                             return best
     return best
+
+
+def _take_outs(bar: _Bar, inset: float, take_at: float, gap: ArmGap) -> list[float]:
+    """Where from the middle (m) the careful taker may take the object: ``take_at``; where
+    a requirement asks the hands to come together (``aligned``), also TAKE_NEARER nearer
+    the giver's hand in turn, keeping them HANDS_APART (a 20 cm bar taken by both ends
+    leaves the hands 15 cm apart)."""
+    if not gap.asks_aligned:
+        return [take_at]
+    least = HANDS_APART - (float(bar.half[0]) - inset)
+    return [take_at, *(take_at - d for d in TAKE_NEARER if take_at - d >= least)]
 
 
 def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, taker: str) -> Plan:
@@ -399,13 +413,14 @@ def _handover_by_the_ends(world: World, style: Style, obj: str, giver: str, take
     now = _Bar.of(world, obj)
     line = now.line if now.line @ toward >= 0 else -now.line
     take_at = meet.take_at if style.avoid_hazards else 0.0  # careless: the middle
-    if style.avoid_hazards and _tilt(now) > HANGS_TILTED:
+    gap = ArmGap(world, giver, taker)
+    if style.avoid_hazards and _tilt(now) > HANGS_TILTED and not gap.asks_aligned:
         # it has turned in the giver's fingers and hangs: taken by its far end as it is, it
-        # hangs from the taker's as it did from the giver's
+        # hangs from the taker's as it did from the giver's (unless the hands must come
+        # together: then where the plan put the taker, nearer the giver's hand)
         take_at = float(now.half[0]) - meet.inset
     take = _taker_grasp(world, taker, now, now.centre, line, take_at, meet.tilt)
     above = meet.above
-    gap = ArmGap(world, giver, taker)
     if style.avoid_hazards and gap.watched:
         q_giver = np.asarray(world.arm_joints(giver), dtype=np.float64)
         margins = {h: _exchange_margin(world, gap, giver, taker, q_giver, take, h)
