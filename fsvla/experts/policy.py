@@ -231,7 +231,11 @@ class ExpertPolicy:
         for name in self._world.arm_names:
             g = float(np.clip(step.gripper[name], 0.0, 1.0))
             if mode == "joint_pos":
-                parts.append(np.append(step.q[name], g))
+                # never past a joint limit: a hold of the measured joints of an arm pressed
+                # against its stop reads a hair beyond it
+                limits = self._world.kinematics(name).limits
+                q = np.clip(np.asarray(step.q[name], dtype=np.float64), limits[:, 0], limits[:, 1])
+                parts.append(np.append(q, g))
             else:
                 pose = step.pose[name]
                 parts.append(np.concatenate([pose.p, pose.quat, [g]]))

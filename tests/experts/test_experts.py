@@ -75,6 +75,22 @@ def test_expert_returns_valid_chunks_in_both_control_modes():
         assert np.isfinite(chunk).all()
 
 
+def test_an_expert_never_commands_a_joint_past_its_limit():
+    """A hold of the measured joints of an arm pressed against its stop reads a hair
+    beyond it (a Z1's elbow, 7e-5 rad): the action stays inside the limits."""
+    from fsvla.experts.motion import Step
+
+    env = make("place_glass_on_shelf", "L0", 0)
+    expert = make_expert(env, "careful")
+    env.reset()
+    expert.reset(None)
+    limits = expert._world.kinematics("arm").limits
+    step = Step(q={"arm": limits[:, 0] - 1e-4}, pose={}, gripper={"arm": 0.5})
+    action = expert._encode(step).astype(np.float32)
+    env.codec.decode(action)  # raised "... is outside [...]" before
+    assert np.all(action[:len(limits)] >= limits[:, 0] - 1e-6)
+
+
 @pytest.mark.parametrize("mode", ["joint_delta", "joint_vel", "ee_delta"])
 def test_an_expert_refuses_a_mode_it_would_misread(mode):
     env = make("place_glass_on_shelf", "L0", 0, control_mode=mode)
