@@ -230,3 +230,34 @@ def test_the_arm_that_lifted_the_lid_moves_out_of_the_carry(tmp_path, level):
     result = rollout(str(path), "careful", level, layout_seed(0, 0))
     assert result.safe_success, result.summary()
     assert result.segments.count("park") == 2  # at the start, and after the lid
+
+
+#: A Z1 puts a block into a shut lidded box; its fingers are thicker than the lid's knob
+#: stands out, so its pinch of the knob's ends feels nothing.
+Z1_LIDDED = """\
+scenario z1_block_into_lidded_box
+  suite temporal
+  task insert(object=block, target=lidded_box)
+  embodiment z1
+  instruction "Put the block into the lidded box."
+  horizon 50 s
+
+  object block: block(size=(4 cm, 4.5 cm, 3.5 cm), mass=110 g, color=yellow) at (2.1 cm, 18.2 cm) yaw -11 deg
+  object lidded_box: lidded_box(size=(15.9 cm, 10.3 cm, 7.7 cm)) at (33.9 cm, 3 cm)
+
+  require pre: opened(lidded_box, fraction=0.6) before inside(block, lidded_box)
+
+  success inside(block, lidded_box) and released(block) for 0.5 s
+"""
+
+
+def test_a_knob_the_fingers_cannot_pinch_is_lifted_from_below_before_an_insert(tmp_path):
+    """As `open` does: the careful expert lifts the lid from below (it raised "closed on
+    nothing" before), and safely."""
+    from fsvla.run.plan import layout_seed
+
+    path = tmp_path / "z1_lidded.fsv"
+    path.write_text(Z1_LIDDED, encoding="utf-8")
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert "lift lid" in result.segments, result.segments
+    assert not result.violation, result.summary()

@@ -149,8 +149,10 @@ def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan
     angle = min(angle, 0.95 * span)
     if _knob_height(world, target) < KNOB_LIFTED_FROM_BELOW and knob_pinch_fits(world, target):
         # too low for the hand upright under the knob (it meets the table): pinched by its
-        # ends, as `open` does, and past upright (held short of it, it would keep the hand)
-        yield from swing_lid(world, style, target, angle)
+        # ends, as `open` does, and past upright (held short of it, it would keep the hand);
+        # fingers too thick to hold the knob's ends lift it from below instead, as `open`'s
+        yield from swing_lid(world, style, target, angle,
+                             missed=lambda: lift_lid(world, style, target, angle))
     else:
         yield from lift_lid(world, style, target, angle)
     arm = carrying_arm(world, obj, target)
