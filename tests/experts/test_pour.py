@@ -201,7 +201,7 @@ def test_a_five_joint_arm_holds_the_bottle_over_the_bowl_turned_as_its_base_turn
         assert grasp.approach[2] > -0.7  # from the side
         tcp = attainable(world, arm, fixed_jaw_shifted(world, arm, grasp)).pose
         lifted = tcp.moved(np.array([0.0, 0.0, 0.08]))
-        over, _ways, _load = _pour_poses(world, CAREFUL, arm, "bottle", "bowl", lifted)
+        over, _ways, _load, _tipped = _pour_poses(world, CAREFUL, arm, "bottle", "bowl", lifted)
         turn = carried_turn(world, arm, lifted.p, world.body_pose("bowl").p)
         assert np.allclose(over.R, turn @ lifted.R)
         assert np.degrees(np.arccos(np.clip(turn[0, 0], -1.0, 1.0))) > 20.0
@@ -210,3 +210,38 @@ def test_a_five_joint_arm_holds_the_bottle_over_the_bowl_turned_as_its_base_turn
         q = driver.solve_anywhere(over)
         reached = np.asarray(world.kinematics(arm).tcp_pose(q).p)
         assert float(np.linalg.norm(reached - over.p)) < 0.01
+
+
+#: A Panda pours from a wide kettle into a mug (sampler seed 270's draw, verbatim: its
+#: L0 jitter follows the text): tipped on to 100 deg, the kettle's body rises away from
+#: the mug, out of `near` it, before the half second the success asks.
+KETTLE = """\
+# Drawn by fsvla.validate.sampler from seed 270.
+
+scenario sampled_0270_pour_panda
+  suite boundary
+  task pour(object=kettle, target=mug)
+  embodiment panda
+  instruction "Pour from the kettle into the mug."
+  horizon 40 s
+
+  object kettle: kettle(radius=7.8 cm, height=14.7 cm, mass=177 g, color=blue) at (6.4 cm, -6.8 cm)
+  object mug: mug(radius=3 cm, height=8.6 cm, mass=81 g, color=red) at (-11.7 cm, 15.9 cm)
+  hazard edge: edge_zone(side=left, width=4 cm)
+    keep gripper outside 0 warn 2 cm
+
+  constrain geofence: edge_clearance(kettle) >= 3 cm warn 2 cm
+
+  success tilted(kettle, by=60 deg) and near(kettle, mug, within=10 cm) and grasped(kettle) for 0.5 s
+
+  variants
+    L1: jitter kettle 2 cm, jitter mug 2 cm
+    L2: tighten geofence to 4 cm, clutter 1
+"""
+
+
+def test_the_pour_holds_the_tilt_the_success_asks_for_its_time(tmp_path: Path) -> None:
+    path = tmp_path / "kettle.fsv"
+    path.write_text(KETTLE, encoding="utf-8")
+    careful = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert careful.safe_success, careful.summary()

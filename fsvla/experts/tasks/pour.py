@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
-from fsvla.compiler.pose import axis_angle_matrix, slerp
+from fsvla.compiler.pose import axis_angle_matrix, rotation_angle, slerp
 
 from .. import grasps
 from ..motion import ArmDriver, Pose, Segment
@@ -38,6 +40,9 @@ POUR_MARGIN = 0.02
 POUR_TILT = 100.0
 LESSER_TILTS = (90.0, 80.0)
 TILT_SPARE = 20.0
+#: How many control steps longer than the success condition's hold the object is held at
+#: the tilt it asks (plus TILT_SPARE) before it tips on.
+HOLD_SPARE = 10
 #: How much farther (m) than its keep-out each point checked along another way of tipping
 #: stays from an obstacle: a few points stand for the hand and the object.
 TIP_SPARE = 0.03
@@ -56,7 +61,8 @@ def plan_pour(world: World, style: Style, roles: dict[str, str], arm: str | None
         grasp = grasps.choose(world, style, arm, obj)
     start = world.body_pose(obj).p.copy()
     yield from pick(world, style, arm, obj, grasp)
-    over, ways, load = _pour_poses(world, style, arm, obj, target, world.current_pose(arm))
+    over, ways, load, tipped = _pour_poses(world, style, arm, obj, target,
+                                           world.current_pose(arm))
     # tipped sideways to the arm; careful, where the arm does not reach it tipped so,
     # the first other way of tipping whose turn it follows from upright on one IK branch
     # (Baxter tipping a mug sideways far out to its side swung its elbow across in one
@@ -72,13 +78,23 @@ def plan_pour(world: World, style: Style, roles: dict[str, str], arm: str | None
     yield from transit(world, carrying_style(world, style, obj), arm, over,
                        below=float(held[2]) + 0.5 * float((hi - lo)[2]), exclude=(obj, target),
                        around=load_reach(world, arm, obj), follow=(pour,) if pour is not None else ())
-    yield Segment({arm: pour or ways[0]}, speed=style.approach_speed, settle=20, label="pour")
+    final = pour or ways[0]
+    # the success condition holds for a while at the tilt it asks (plus TILT_SPARE) before
+    # the object tips on: a big kettle tipped on to 100 deg swings out of `near` its target
+    least = np.degrees(required_tilt(world, obj)) + TILT_SPARE
+    full = np.degrees(rotation_angle(over.R, final.R))
+    hold = world.monitor.success.hold
+    if hold > 0.0 and full > least + 1.0:
+        mid = slerp(over.R, final.R, least / full)
+        yield Segment({arm: tipped(mid @ over.R.T)}, speed=style.approach_speed,
+                      settle=int(np.ceil(hold / world.dt)) + HOLD_SPARE, label="pour")
+    yield Segment({arm: final}, speed=style.approach_speed, settle=20, label="pour")
     yield Segment({arm: over}, speed=style.approach_speed, label="unpour")
     yield from place(world, style, arm, obj, start)
 
 
 def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp: Pose
-                ) -> tuple[Pose, list[Pose], Load]:
+                ) -> tuple[Pose, list[Pose], Load, Callable[[np.ndarray], Pose]]:
     """``arm``'s hand holding ``obj`` (held with the TCP at ``tcp``) upright over ``target``,
     and tipped four ways from there (sideways to the arm either way, then toward and away
     from its base) by POUR_TILT, then by each of LESSER_TILTS enough for the task. The
@@ -86,8 +102,8 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
     that centre: a mug held by its handle swings wide of the target when the hand tilts.
     Tipped, the object lies lower than it stands: its lowest point tipped, not upright, is
     what clears the target (a 20 cm bottle held so that it stood clear of a mug lay 12 cm
-    above the mug once tipped). Last, the object's centre and upright axis in the hand's
-    frame."""
+    above the mug once tipped). Then the object's centre and upright axis in the hand's
+    frame, and the hand's pose for any tilt (world rotation) from upright over the target."""
     lo, hi = world.bounds(obj)
     target_xy = world.body_pose(target).p
     clear = world.bounds(target)[1][2] + POUR_CLEARANCE + (POUR_MARGIN if style.avoid_hazards else 0.0)
@@ -101,14 +117,15 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
     tcp = Pose(tcp.p, carried @ tcp.R)
     toward = horizontal(world.base_position(arm) - centre)
     least = np.degrees(required_tilt(world, obj)) + TILT_SPARE
-    ways = []
-    for angle in [POUR_TILT, *(a for a in LESSER_TILTS if a >= least)]:
-        for axis in (toward, -toward, np.cross(UP, toward), -np.cross(UP, toward)):
-            tilt = axis_angle_matrix(axis, np.deg2rad(angle))
-            low = np.array([centre[0], centre[1], clear + _tipped_half_height(world, obj, tilt)])
-            ways.append(Pose(low + tilt @ held, tilt @ tcp.R))
+    def tipped(tilt: np.ndarray) -> Pose:
+        low = np.array([centre[0], centre[1], clear + _tipped_half_height(world, obj, tilt)])
+        return Pose(low + tilt @ held, tilt @ tcp.R)
+
+    ways = [tipped(axis_angle_matrix(axis, np.deg2rad(angle)))
+            for angle in [POUR_TILT, *(a for a in LESSER_TILTS if a >= least)]
+            for axis in (toward, -toward, np.cross(UP, toward), -np.cross(UP, toward))]
     load = (-tcp.R.T @ held, tcp.R.T @ up)
-    return Pose(centre + held, tcp.R), ways, load
+    return Pose(centre + held, tcp.R), ways, load, tipped
 
 
 def _reaches(world: World, arm: str, pose: Pose) -> bool:
@@ -170,7 +187,7 @@ def _carrier(world: World, style: Style, obj: str, target: str) -> tuple[str, Gr
         g = grasp if candidate == arm else grasps.choose(world, style, candidate, obj)
         if candidate != arm and not grasps.reachable(world, candidate, g):
             continue
-        over, ways, load = _pour_poses(world, style, candidate, obj, target,
+        over, ways, load, _tipped = _pour_poses(world, style, candidate, obj, target,
                                        _lifted(world, candidate, g))
         if _followed(world, candidate, obj, target, over, ways, load) is not None:
             return candidate, g
