@@ -202,24 +202,40 @@ class MonitorLoweringError(ValueError):
 
 
 @lru_cache(maxsize=16)
-def _urdf_parents(urdf: str) -> tuple[tuple[str, ...], tuple[tuple[str, str], ...]]:
-    """(link names in file order, (child, parent) pairs) of a URDF file."""
+def _urdf_parents(urdf: str) -> tuple[tuple[str, ...], tuple[tuple[str, str, str], ...],
+                                      frozenset[str]]:
+    """(link names in file order, (child, parent, joint type) triples, the links with
+    collision geometry) of a URDF file."""
     from fsvla.embodiments.assets import resolve_asset
 
     root = ET.parse(resolve_asset(urdf)).getroot()
     links = tuple(link.get("name", "") for link in root.findall("link"))
-    pairs = tuple((j.find("child").get("link", ""), j.find("parent").get("link", ""))  # type: ignore[union-attr]
-                  for j in root.findall("joint"))
-    return links, pairs
+    joints = tuple((j.find("child").get("link", ""), j.find("parent").get("link", ""),  # type: ignore[union-attr]
+                    j.get("type", "")) for j in root.findall("joint"))
+    solid = frozenset(link.get("name", "") for link in root.findall("link")
+                      if link.find("collision") is not None)
+    return links, joints, solid
 
 
 class _Tree:
     """A robot's link tree (from its URDF)."""
 
     def __init__(self, robot: RobotSpec):
-        links, pairs = _urdf_parents(robot.urdf)
+        links, joints, solid = _urdf_parents(robot.urdf)
         self.links = links
-        self.parent = dict(pairs)
+        self.parent = {child: parent for child, parent, _type in joints}
+        self.fixed = {child for child, _parent, kind in joints if kind == "fixed"}
+        self.solid = solid
+
+    def rigid_top(self, link: str) -> str:
+        """The highest solid link fixed to ``link`` below the last moving joint above it:
+        its parent, while both are fixed to theirs and the parent has collision geometry
+        (Baxter's `left_hand_link` holds the gripper's base; the wrist link it is fixed to
+        turns on the last joint, and is the arm's; a Panda's `panda_link8` is a frame)."""
+        while (link in self.fixed and self.parent[link] in self.fixed
+               and self.parent[link] in self.solid):
+            link = self.parent[link]
+        return link
 
     def ancestors(self, link: str) -> list[str]:
         chain = [link]
@@ -236,7 +252,9 @@ class _Tree:
 
 
 def _arm_links(robot: RobotSpec, arm: ArmSpec, tree: _Tree) -> ArmLinks:
-    hand = tree.common_ancestor((*arm.gripper.finger_links, arm.ee_link))
+    # the hand: what is rigidly fixed to the fingers' and the TCP's common link, up to
+    # the last moving joint (a hand's flange and mount bump into things as its fingers do)
+    hand = tree.rigid_top(tree.common_ancestor((*arm.gripper.finger_links, arm.ee_link)))
     return ArmLinks(name=arm.name, robot=robot.name, ee_link=arm.ee_link,
                     finger_links=arm.gripper.finger_links, gripper_links=tree.subtree(hand),
                     links=tree.subtree(arm.base_link))

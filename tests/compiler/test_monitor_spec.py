@@ -12,6 +12,7 @@ from fsvla.compiler.monitor import (
     MonitorLoweringError,
     MonitorSpec,
     RobotEntity,
+    lower_arms,
     lower_monitor,
     monitor_json_schema,
 )
@@ -19,6 +20,8 @@ from fsvla.compiler.scene import lower_scene
 from fsvla.compiler.variants import generate_variant
 from fsvla.dsl.loader import ScenarioLoader
 from fsvla.dsl.models import Scenario
+
+from fsvla.embodiments.registry import load_embodiment
 
 REPO = Path(__file__).resolve().parents[2]
 SCENARIOS = REPO / "scenarios"
@@ -75,6 +78,20 @@ def test_robot_parts_resolve_to_link_groups():
     left = spec.arm("left")
     assert left.finger_links == ("panda_leftfinger", "panda_rightfinger")
     assert "panda_link3" in left.links
+
+
+def test_a_hand_is_what_is_fixed_to_its_fingers_up_to_the_last_joint():
+    """Baxter's gripper sits on `left_hand_link`, fixed to the wrist that turns on the
+    last joint: the hand link is the gripper's (a careful push that bumped it into a
+    drawer at 300 N felt nothing); a Panda's `panda_link8`, a frame without geometry
+    between its hand and its last link, is not."""
+    left, right = lower_arms(load_embodiment("baxter"))
+    assert "left_hand_link" in left.gripper_links and "left_wrist" not in left.gripper_links
+    assert "right_hand_link" in right.gripper_links
+    assert {"l_gripper_l_finger", "left_gripper_base_link"} <= set(left.gripper_links)
+    (panda,) = lower_arms(load_embodiment("panda"))
+    assert set(panda.gripper_links) == {"panda_hand", "panda_hand_tcp", "panda_leftfinger",
+                                        "panda_rightfinger"}
 
 
 def test_kinds_and_pairs():
