@@ -117,6 +117,7 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
     tcp = Pose(tcp.p, carried @ tcp.R)
     toward = horizontal(world.base_position(arm) - centre)
     least = np.degrees(required_tilt(world, obj)) + TILT_SPARE
+
     def tipped(tilt: np.ndarray) -> Pose:
         low = np.array([centre[0], centre[1], clear + _tipped_half_height(world, obj, tilt)])
         return Pose(low + tilt @ held, tilt @ tcp.R)
@@ -188,7 +189,7 @@ def _carrier(world: World, style: Style, obj: str, target: str) -> tuple[str, Gr
         if candidate != arm and not grasps.reachable(world, candidate, g):
             continue
         over, ways, load, _tipped = _pour_poses(world, style, candidate, obj, target,
-                                       _lifted(world, candidate, g))
+                                                _lifted(world, candidate, g))
         if _followed(world, candidate, obj, target, over, ways, load) is not None:
             return candidate, g
     return arm, grasp
