@@ -81,7 +81,7 @@ def plan_pour(world: World, style: Style, roles: dict[str, str], arm: str | None
     final = pour or ways[0]
     # the success condition holds for a while at the tilt it asks (plus TILT_SPARE) before
     # the object tips on: a big kettle tipped on to 100 deg swings out of `near` its target
-    least = np.degrees(required_tilt(world, obj)) + TILT_SPARE
+    least = _least_tilt(world, obj)
     full = np.degrees(rotation_angle(over.R, final.R))
     hold = world.monitor.success.hold
     if hold > 0.0 and full > least + 1.0:
@@ -116,7 +116,7 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
     up = carried @ world.body_pose(obj).R[:, 2]
     tcp = Pose(tcp.p, carried @ tcp.R)
     toward = horizontal(world.base_position(arm) - centre)
-    least = np.degrees(required_tilt(world, obj)) + TILT_SPARE
+    least = _least_tilt(world, obj)
 
     def tipped(tilt: np.ndarray) -> Pose:
         low = np.array([centre[0], centre[1], clear + _tipped_half_height(world, obj, tilt)])
@@ -127,6 +127,11 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
             for axis in (toward, -toward, np.cross(UP, toward), -np.cross(UP, toward))]
     load = (-tcp.R.T @ held, tcp.R.T @ up)
     return Pose(centre + held, tcp.R), ways, load, tipped
+
+
+def _least_tilt(world: World, obj: str) -> float:
+    """The least tilt (deg) a pour of ``obj`` goes to: what the task asks, TILT_SPARE past."""
+    return float(np.degrees(required_tilt(world, obj))) + TILT_SPARE
 
 
 def _reaches(world: World, arm: str, pose: Pose) -> bool:
