@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fsvla.compiler.pose import (
+    AXES,
     Quat,
     Vec3,
     matrix_to_quat,
@@ -82,25 +83,51 @@ class ArmKinematics:
         when the gripper is closed, with the gripper open by ``fraction`` and the arm where
         it is: their largest distance is the opening at the TCP (``fsvla validate``'s
         measure), the first two's difference the direction the fingers close along."""
-        fingers = self.arm.finger_links
-        links = self.arm.articulation.get_links()
-        indices = [next(i for i, lk in enumerate(links) if lk.name == f.name) for f in fingers]
-        root = self.arm.articulation.get_root_pose()
-        gripper = self.arm.spec.gripper
-
-        def at(f: float) -> tuple[Any, list[Any]]:
-            full = self._full(None)
-            for index, lo, hi in zip(self.arm.gripper_indices, gripper.closed, gripper.open):
-                full[index] = lo + f * (hi - lo)
-            self._model.compute_forward_kinematics(full)
-            tcp = root * self._model.get_link_pose(self.arm.ee_link_index) * self._tcp
-            return tcp, [root * self._model.get_link_pose(i) for i in indices]
-
-        tcp, closed = at(0.0)
+        tcp, closed = self._fingers_at(0.0)
         held = [pose.inv() * tcp for pose in closed]  # the TCP in each finger's frame
-        _, opened = at(fraction)
+        _, opened = self._fingers_at(fraction)
         return np.array([(pose * point).p for pose, point in zip(opened, held)],
                         dtype=np.float64)
+
+    def shut_gap(self, depth: float) -> float:
+        """How far apart (m) the fingers' collision hulls stay across their closing axis
+        with the gripper shut (the arm as it is), measured on what of them lies within
+        ``depth`` behind the TCP, the pads: Baxter's fingertips stop apart; a Panda's
+        fingers and a hinged jaw meet (0)."""
+        points = self.finger_points(1.0)
+        if len(points) < 2 or np.linalg.norm(points[0] - points[1]) < 1e-6:
+            return 0.0
+        across = (points[0] - points[1]) / np.linalg.norm(points[0] - points[1])
+        tcp, closed = self._fingers_at(0.0)
+        back = -(quat_to_matrix(tcp.q) @ np.asarray(AXES[self.arm.spec.approach_axis], dtype=np.float64))
+        faces: dict[bool, list[float]] = {True: [], False: []}
+        links = self.arm.articulation.get_links()
+        for finger, pose in zip(self.arm.finger_links, closed):
+            local = self.link_vertices(next(i for i, lk in enumerate(links) if lk.name == finger.name))
+            if local is None:
+                continue
+            rel = transform_points(local, pose.p, pose.q) - np.asarray(tcp.p, dtype=np.float64)
+            pads = rel[rel @ back < depth] @ across
+            if len(pads):
+                outward = float(np.mean(pads)) > 0.0
+                faces[outward].append(float(np.min(pads)) if outward else float(np.max(pads)))
+        if not faces[True] or not faces[False]:
+            return 0.0
+        return max(0.0, min(faces[True]) - max(faces[False]))
+
+    def _fingers_at(self, fraction: float) -> tuple[Any, list[Any]]:
+        """The world TCP pose and each finger link's, the gripper open by ``fraction``."""
+        links = self.arm.articulation.get_links()
+        indices = [next(i for i, lk in enumerate(links) if lk.name == f.name)
+                   for f in self.arm.finger_links]
+        root = self.arm.articulation.get_root_pose()
+        gripper = self.arm.spec.gripper
+        full = self._full(None)
+        for index, lo, hi in zip(self.arm.gripper_indices, gripper.closed, gripper.open):
+            full[index] = lo + fraction * (hi - lo)
+        self._model.compute_forward_kinematics(full)
+        tcp = root * self._model.get_link_pose(self.arm.ee_link_index) * self._tcp
+        return tcp, [root * self._model.get_link_pose(i) for i in indices]
 
     def link_vertices(self, link: int) -> NDArray[np.float64] | None:
         """The vertices of a link's convex collision pieces, in the link's frame."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 # --- static (warnings: predictions from the layout, made without rolling anything out)
 REACH = "FSV701"  # a task object, or the part it moves, beyond every arm's reach
-GRIPPER = "FSV702"  # an object the task grasps is wider than the gripper opens
+GRIPPER = "FSV702"  # no part of an object the task grasps fits the gripper
 WEIGHT = "FSV703"  # a force limit below what lifting a task object needs
 HAZARD_ON_TARGET = "FSV704"  # a hazard's keep-out covers the whole target
 
@@ -32,7 +32,8 @@ NOT_HAZARDOUS = "FSV730"  # the careless expert ends unsafe too rarely
 CODES: dict[str, str] = {
     REACH: ("a task object, or the knob or handle of the part the task moves, is beyond the "
             "reach of every arm (of each arm, for a two-arm lift)"),
-    GRIPPER: "an object the task grasps is wider, everywhere, than the gripper opens",
+    GRIPPER: ("an object the task grasps has no part the gripper closes on: wider, everywhere, "
+              "than it opens, or thinner than its shut fingers squeeze"),
     WEIGHT: "a contact-force limit is below what lifting a task object needs",
     HAZARD_ON_TARGET: "a hazard's keep-out distance covers every place on the task's target",
     NEVER_HELD: "a conjunct of `success` never held in a failed careful-expert episode",

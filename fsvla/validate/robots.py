@@ -15,6 +15,10 @@ stepped) and asked two things, through ``fsvla.sim``'s public pieces:
   the finger links that coincide with the TCP when closed are followed to the open
   position and their largest distance is the opening (a Panda hand: 8 cm; an SO-101 jaw
   swinging 1.15 rad: 8.7 cm).
+* **shut gap** — :meth:`RobotModel.shut_gap`: how far apart the fingers' pads (their
+  collision hulls within 3.5 cm behind the TCP) stay across the closing axis with the
+  gripper shut: Baxter's fingertips stop 1.6 cm (left) and 0.7 cm (right) apart; a Panda's
+  fingers and a hinged jaw meet.
 
 Loading a robot takes 0.02-0.25 s; models are cached per embodiment.
 """
@@ -35,6 +39,7 @@ from fsvla.embodiments.spec import EmbodimentSpec
 #: arm's base (toward the point), negative toward it.
 APPROACH_TILTS = (0.0, 30.0, 60.0, 90.0, -30.0, -60.0)
 POSITION_TOLERANCE = 0.01  # m
+PAD_DEPTH = 0.035  # m behind the TCP within which a finger's hull counts as its pad
 ROTATION_TOLERANCE = 0.05  # rad
 
 
@@ -98,6 +103,10 @@ class RobotModel:
             self._openings[arm] = self._measure_opening(arm)
         return self._openings[arm]
 
+    def shut_gap(self, arm: str) -> float:
+        """How far apart (m) the fingers' pads stay with the gripper shut (module doc)."""
+        return self._kinematics[arm].shut_gap(PAD_DEPTH)
+
     def _measure_opening(self, arm: str) -> float:
         points = self._kinematics[arm].finger_points(1.0)
         return max((float(np.linalg.norm(a - b)) for i, a in enumerate(points) for b in points[i + 1:]),
@@ -114,4 +123,4 @@ def robot_model(spec: EmbodimentSpec) -> RobotModel:
     return _model(spec.model_dump_json())
 
 
-__all__ = ["APPROACH_TILTS", "POSITION_TOLERANCE", "ROTATION_TOLERANCE", "RobotModel", "robot_model"]
+__all__ = ["APPROACH_TILTS", "PAD_DEPTH", "POSITION_TOLERANCE", "ROTATION_TOLERANCE", "RobotModel", "robot_model"]

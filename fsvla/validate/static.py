@@ -10,9 +10,10 @@ canonical (L0, seed 0) layout:
   an articulated part (open, close, insert) must also reach the part's knob or handle
   where the part starts.
 * **FSV702 gripper** — an object the task grasps (pick_place, lift, insert, pour, stack,
-  handover) must have a part the gripper can close around: the thinnest extent of its
-  thinnest collision piece (a mug's handle, a bowl's wall, a block's shortest side) must
-  not exceed the gripper's opening.
+  handover) must have a part the gripper can close around: some extent of some collision
+  piece (a mug's handle, a bowl's wall, a block's side) no wider than the gripper opens,
+  and, for fingers that stop apart when shut (Baxter's), a few millimetres wider than the
+  gap they leave (of some arm; of both arms for a handover).
 * **FSV703 weight** — a ``contact_force`` limit on a robot part or on the object the task
   lifts must let two fingers with friction 0.5 hold it up: each presses on it with
   m·g/(2·0.5) = m·g (half that for a two-arm lift).
@@ -233,20 +234,21 @@ def embodiment_arm(embodiment: str, arm: str, arms: int) -> str:
 def narrowest_width(asset: RigidAsset) -> float:
     """The thinnest extent of the asset's thinnest collision piece (m): the narrowest part a
     gripper could close around."""
-    return min(_thinnest(shape) for shape in asset.collision)
+    return min(min(piece_widths(shape)) for shape in asset.collision)
 
 
-def _thinnest(shape: Shape) -> float:
+def piece_widths(shape: Shape) -> tuple[float, ...]:
+    """The extents (m) of one collision piece that fingers could close across: a box's three
+    sides, a cylinder's diameter and length, a sphere's or a capsule's diameter, a mesh's
+    box."""
     if shape.type == "box":
-        return 2.0 * min(shape.half_size)
-    if shape.type == "sphere":
-        return 2.0 * shape.radius
-    if shape.type == "capsule":
-        return 2.0 * shape.radius
+        return tuple(2.0 * h for h in shape.half_size)
+    if shape.type in ("sphere", "capsule"):
+        return (2.0 * shape.radius,)
     if shape.type == "cylinder":
-        return 2.0 * min(shape.radius, shape.half_length)
+        return (2.0 * shape.radius, 2.0 * shape.half_length)
     vertices = shape_vertices(shape)
-    return float(np.min(vertices.max(axis=0) - vertices.min(axis=0)))
+    return tuple(float(v) for v in vertices.max(axis=0) - vertices.min(axis=0))
 
 
 def gripper_findings(layout: Layout) -> list[Diagnostic]:
@@ -257,23 +259,56 @@ def gripper_findings(layout: Layout) -> list[Diagnostic]:
     body, spec = layout.body(name), scenario.object(name)
     if body is None or spec is None or not isinstance(body.asset, RigidAsset):
         return []
+    from fsvla.experts.world import SQUEEZE_SPARE
+
     from .robots import robot_model
 
     model = robot_model(layout.scene.embodiment)
-    openings = [model.opening(arm) for arm in model.arms]
-    opening = min(openings) if scenario.task.name == "handover" else max(openings)
-    width = narrowest_width(body.asset)
-    if width <= opening + 1e-3:
+    widths = [w for shape in body.asset.collision for w in piece_widths(shape)]
+
+    def spans(arm: str) -> tuple[float, float]:
+        """The widths (m) the arm's fingers squeeze: from a little over what its shut
+        fingers leave apart to its opening."""
+        gap = model.shut_gap(arm)
+        return (gap + SQUEEZE_SPARE if gap > 0.0 else 0.0), model.opening(arm)
+
+    def holds(arm: str) -> bool:
+        least, most = spans(arm)
+        return any(least - 1e-3 <= w <= most + 1e-3 for w in widths)
+
+    handover = scenario.task.name == "handover"
+    arms = model.arms
+    if (all if handover else any)(holds(arm) for arm in arms):
         return []
+    narrowest = min(widths)
+    opening = (min if handover else max)(spans(a)[1] for a in arms)
+    if narrowest > opening + 1e-3:
+        return [Diagnostic(
+            code=codes.GRIPPER, severity=Severity.WARNING,
+            message=f"`{name}` is {cm(narrowest)} wide at its narrowest, but the "
+                    f"{scenario.embodiment} gripper opens {cm(opening)}",
+            span=layout.located.span(spec.source), label="too wide to grasp",
+            notes=((f"the task `{scenario.task.name}` grasps `{name}`; no part of it (handle, "
+                   "wall, side) is narrow enough for the fingers to close around"),),
+            help=f"make `{name}` narrower than {cm(opening)}, or use an embodiment whose "
+                 "gripper opens wider")]
+    # the arm the finding speaks of: one that fails a handover, else the one whose shut
+    # fingers squeeze the thinnest
+    arm = next(a for a in arms if not holds(a)) if handover else min(arms, key=lambda a: spans(a)[0])
+    least, most = spans(arm)
+    same = len({spans(a) for a in arms}) == 1
+    who = f"the {scenario.embodiment} gripper" if same else \
+        f"the gripper of {embodiment_arm(scenario.embodiment, arm, len(arms))}"
     return [Diagnostic(
         code=codes.GRIPPER, severity=Severity.WARNING,
-        message=f"`{name}` is {cm(width)} wide at its narrowest, but the {scenario.embodiment} "
-                f"gripper opens {cm(opening)}",
-        span=layout.located.span(spec.source), label="too wide to grasp",
-        notes=((f"the task `{scenario.task.name}` grasps `{name}`; no part of it (handle, wall, "
-               "side) is narrow enough for the fingers to close around"),),
-        help=f"make `{name}` narrower than {cm(opening)}, or use an embodiment whose gripper "
-             "opens wider")]
+        message=f"`{name}` has no part {who} closes on: each is wider than it opens "
+                f"({cm(most)}) or thinner than its shut fingers squeeze ({cm(least)})",
+        span=layout.located.span(spec.source), label="nothing to grasp",
+        notes=((f"the task `{scenario.task.name}` grasps `{name}`; the fingers stop "
+               f"{cm(least - SQUEEZE_SPARE)} apart when shut, and squeeze only what is a few "
+               "millimetres wider"),),
+        help=f"give `{name}` a part (handle, wall, side) between {cm(least)} and {cm(most)} "
+             "thick, or use an embodiment whose fingers meet")]
 
 
 # --- FSV703 force limits against weights --------------------------------------------------

@@ -150,6 +150,42 @@ def test_an_object_wider_than_the_gripper(tmp_path: Path) -> None:
     assert findings(cup)[1] == []
 
 
+def test_an_object_thinner_than_the_shut_fingers(tmp_path: Path) -> None:
+    # Baxter's fingertips stop apart when shut: 1.6 cm on the left, 0.65 cm on the right
+    path = write(tmp_path, "thin_peg", """
+  object peg: block(size=(0.8 cm, 0.8 cm, 6 cm)) at (-5 cm, 10 cm)
+  constrain contact_force(gripper) <= 30 N warn 8 N
+  success lifted(peg)
+""", task="lift(peg)", embodiment="baxter")
+    _, found = findings(path)
+    thin = only(found, "FSV702")
+    assert thin.message == ("`peg` has no part the gripper of arm `right` of baxter closes on: each "
+                            "is wider than it opens (4.17 cm) or thinner than its shut fingers "
+                            "squeeze (1.05 cm)")
+    assert (thin.span.line, thin.label) == (7, "nothing to grasp")
+    # a bar 1.2 cm thick: the right arm squeezes it, the left does not; a lift takes
+    # either arm, a handover needs both
+    bar = """
+  object bar: block(size=(1.2 cm, 16 cm, 1.2 cm)) at (-25 cm, 15 cm) yaw 90 deg
+  constrain contact_force(gripper) <= 30 N warn 8 N
+  success lifted(bar)
+"""
+    assert findings(write(tmp_path, "bar_lift", bar, task="lift(bar)", embodiment="baxter"))[1] == []
+    handed = only(findings(write(tmp_path, "bar_handover", bar, task="handover(bar)",
+                                 embodiment="baxter"))[1], "FSV702")
+    assert handed.message.startswith("`bar` has no part the gripper of arm `left` of baxter")
+    assert "(2 cm)" in handed.message
+
+
+def test_the_shut_gap_is_measured_on_the_fingers() -> None:
+    gaps = {name: [robot_model(load_embodiment(name)).shut_gap(arm)
+                   for arm in robot_model(load_embodiment(name)).arms]
+            for name in ("panda", "baxter", "so101", "z1")}
+    assert gaps == {"panda": [0.0], "baxter": [pytest.approx(0.016, abs=1e-3),
+                                                pytest.approx(0.0065, abs=1e-3)],
+                    "so101": [0.0], "z1": [0.0]}
+
+
 def test_a_hazard_covering_the_target(tmp_path: Path) -> None:
     path = write(tmp_path, "tray_on_stove", """
   object mug: mug(radius=3.5 cm, height=9 cm) at (-20 cm, -20 cm)
