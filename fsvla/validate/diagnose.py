@@ -1,10 +1,11 @@
 """From a failed verdict to its diagnostics: which episodes to read, which explanation.
 
 =============  ==================================================================
-solvable       careful-expert faults (FSV713), the limits it crossed (FSV712), and
+solvable       careful-expert faults (FSV713), the limits it crossed (FSV712; a
+               contact-force limit with a replay of what pressed), and
                for its first episode that completed without success, a replay of
                which part of ``success`` never held (FSV710, FSV711)
-starts safe    hold-still faults (FSV723), crossings (FSV721), channels in their
+starts safe    hold-still faults (FSV723), crossings (FSV721, as FSV712), channels in their
                warning band at the first step (FSV720) or later (FSV722), success
                while holding still (FSV724)
 hazardous      one note on the scenario's line (FSV730)
@@ -13,7 +14,7 @@ hazardous      one note on the scenario's line (FSV730)
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +45,7 @@ def diagnose(located: Located, verdict: Verdict, rows: Sequence[Any], run_dir: P
         found = fault_diagnostics(located, level, failed, code=codes.CAREFUL_FAULT,
                                   who="the careful expert")
         found += violation_diagnostics(located, level, failed, code=codes.CAREFUL_VIOLATION,
-                                       who="the careful expert")
+                                       who="the careful expert", pressed=_pressed(run_dir))
         unsuccessful = [r for r in failed if r.status == "completed" and not r.success]
         if unsuccessful:
             found += _replayed(located, level, unsuccessful[0], run_dir, len(failed), len(rows))
@@ -52,7 +53,7 @@ def diagnose(located: Located, verdict: Verdict, rows: Sequence[Any], run_dir: P
     failed = [r for r in rows if not safe_at_rest(r, thresholds.hold_ret)]
     found = fault_diagnostics(located, level, failed, code=codes.HOLD_FAULT, who="holding still")
     found += violation_diagnostics(located, level, failed, code=codes.HOLD_VIOLATION,
-                                   who="holding still")
+                                   who="holding still", pressed=_pressed(run_dir))
     completed = [r for r in failed if r.status == "completed"]
     found += start_diagnostics(located, level, completed, _traces(run_dir, completed))
     found += done_at_rest_diagnostics(located, level, completed)
@@ -64,6 +65,23 @@ def _traces(run_dir: Path, rows: Sequence[Any]) -> dict[str, Any]:
 
     with ResultStore.open(run_dir, readonly=True) as store:
         return {r.episode_id: store.trace(r.episode_id) for r in rows if r.trace_path}
+
+
+def _pressed(run_dir: Path) -> Callable[[Any, str], str | None]:
+    """What pressed on a crossed contact-force channel's subject in an episode (a replay,
+    :func:`~.crossing.replay_crossing`), as a note; a replay that fails says so."""
+    from .crossing import replay_crossing
+
+    def pressed(row: Any, channel: str) -> str | None:
+        if not row.trace_path:
+            return None
+        try:
+            crossing = replay_crossing(run_dir, row.episode_id, channel)
+        except Exception as problem:  # noqa: BLE001 - a replay that fails must not end validate
+            return (f"replaying {row.episode_id} to see what pressed did not work: "
+                    f"{type(problem).__name__}: {problem}")
+        return None if crossing is None else crossing.text()
+    return pressed
 
 
 def _replayed(located: Located, level: str, row: Any, run_dir: Path, failed: int,

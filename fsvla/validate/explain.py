@@ -13,7 +13,7 @@ limit the episode ran under.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,6 +35,7 @@ class Channel:
     source: SourceRef
     text: str  # `contact_force(gripper) <= 20 N`, or `require both_hands`
     comparison: str | None = None  # None: a temporal requirement
+    metric: str = ""  # contact_force, clearance, ...; "" for a requirement
     limit: float = 0.0
     unit: str = ""
     soft_threshold: float = 0.0
@@ -56,7 +57,7 @@ def channels_at(scenario: Scenario, level: str) -> dict[str, Channel]:
     for limit in varied.limits:
         found[limit.name] = Channel(
             name=limit.name, source=limit.source, text=limit_text(limit),
-            comparison=limit.comparison, limit=limit.limit, unit=limit.unit,
+            comparison=limit.comparison, metric=limit.metric, limit=limit.limit, unit=limit.unit,
             soft_threshold=limit.soft_threshold)
     for req in varied.requirements:
         name = req.name if req.name not in found else f"{req.name} (require)"
@@ -89,9 +90,12 @@ def _plural(n: int, word: str) -> str:
 
 
 def violation_diagnostics(located: Located, level: str, rows: Sequence[Any], *,
-                          code: str, who: str) -> list[Diagnostic]:
+                          code: str, who: str,
+                          pressed: Callable[[Any, str], str | None] | None = None
+                          ) -> list[Diagnostic]:
     """One diagnostic per channel crossed in ``rows``, on the channel's line, with the worst
-    value observed and where."""
+    value observed and where; for a crossed ``contact_force`` limit, what ``pressed``
+    (given the worst episode's row and the channel's name) says pressed on its subject."""
     channels = channels_at(located.scenario, level)
     crossed: dict[str, list[tuple[Any, Any]]] = {}
     for row in rows:
@@ -115,9 +119,13 @@ def violation_diagnostics(located: Located, level: str, rows: Sequence[Any], *,
             message = (f"{who} crossed `{name}` at {level}: {observed} observed, against "
                        f"`{channel.text}`")
             label = f"{observed} observed"
-        found.append(Diagnostic(
-            code=code, message=message, span=located.span(channel.source), label=label,
-            notes=(f"crossed in {len(hits)} of {_plural(len(rows), 'episode')}; worst: {where}",)))
+        notes = [f"crossed in {len(hits)} of {_plural(len(rows), 'episode')}; worst: {where}"]
+        if pressed is not None and channel.metric == "contact_force":
+            contact = pressed(row, name)
+            if contact is not None:
+                notes.append(contact)
+        found.append(Diagnostic(code=code, message=message, span=located.span(channel.source),
+                                label=label, notes=tuple(notes)))
     return found
 
 
