@@ -13,6 +13,7 @@ limit the episode ran under.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -134,7 +135,9 @@ def violation_diagnostics(located: Located, level: str, rows: Sequence[Any], *,
 
 def fault_diagnostics(located: Located, level: str, rows: Sequence[Any], *, code: str,
                       who: str) -> list[Diagnostic]:
-    """One diagnostic per fault reason among ``rows``, on the scenario's line."""
+    """One diagnostic per fault reason among ``rows``: on the line that declares the first
+    of the scenario's objects the fault's detail names in backticks (an expert that cannot
+    reach a lid's arc names the box), else on the scenario's line."""
     by_reason: dict[str, list[Any]] = {}
     for row in rows:
         if row.status == "faulted":
@@ -143,13 +146,24 @@ def fault_diagnostics(located: Located, level: str, rows: Sequence[Any], *, code
     for reason, faulted in by_reason.items():
         first = faulted[0]
         detail = (first.failure_detail or "").strip().splitlines()
+        named = _named_object(located.scenario, detail[0] if detail else "")
         found.append(Diagnostic(
             code=code, message=f"{_plural(len(faulted), 'episode')} of {who} at {level} "
                                f"ended in a fault: {reason}",
-            span=located.span(located.scenario.source), label=reason,
+            span=located.span(named.source if named is not None else located.scenario.source),
+            label=reason,
             notes=(f"{first.episode_id}: {detail[0] if detail else reason}",),
             help="replay it with `fsvla replay` to see where it fails"))
     return found
+
+
+def _named_object(scenario: Scenario, text: str) -> Any:
+    """The first of ``scenario``'s objects ``text`` names in backticks, or None."""
+    for name in re.findall(r"`([A-Za-z_][A-Za-z0-9_]*)`", text):
+        found = scenario.object(name)
+        if found is not None:
+            return found
+    return None
 
 
 # --- holding still ----------------------------------------------------------------------------

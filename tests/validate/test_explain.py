@@ -109,6 +109,17 @@ def test_faults_are_reported_on_the_scenario_line(located: Located) -> None:
     assert found[0].notes == ("e0: layout infeasible",)
 
 
+def test_a_fault_that_names_an_object_points_at_its_line(located: Located) -> None:
+    detail = ("act() raised NotImplementedError: the careful expert cannot push `tray` shut "
+              "from 99°: no IK branch of `arm` follows its face's arc (at push_shut.py:114)")
+    found = fault_diagnostics(located, "L0", [row("e0", status="faulted", reason="policy_error",
+                                                  detail=detail)],
+                              code="FSV713", who="the careful expert")
+    assert concise(found) == [
+        ("mug_tray.fsv:8:10: FSV713 1 episode of the careful expert at L0 ended in a fault: "
+         "policy_error (replay it with `fsvla replay` to see where it fails)")]
+
+
 def test_hold_still_warning_at_the_start_and_later(located: Located) -> None:
     trace = {"channels": [{"name": "grip", "soft_threshold": 6.0},
                           {"name": "stove", "soft_threshold": 0.03},
