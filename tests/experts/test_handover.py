@@ -65,7 +65,7 @@ def test_exchange_keeps_the_arms_apart(tmp_path: Path, embodiment: str, x: str) 
     held = H._giver_at_meeting(world, "left", grip, bar.centre, toward, meet.middle)
     take = H._taker_grasp(world, "right", bar, meet.middle, toward, meet.take_at, meet.tilt)
     assert (held.p - meet.middle) @ toward < -0.04
-    assert (take.pose.p - meet.middle) @ toward > 0.04
+    assert (take.pose.p - meet.middle) @ toward > 0.04 - 1e-6
     q_giver = branch_for_path(world, "left", (held,))
     assert q_giver is not None
     gap = ArmGap(world, "left", "right")
@@ -286,3 +286,50 @@ def test_the_taker_takes_a_long_bar_near_enough_to_keep_a_required_alignment(
     careful = rollout(str(path), "careful", "L0", SEED)
     assert not careful.violation, careful.summary()
     assert careful.min_margin["pre"] > 0
+
+
+#: The sampler's draw 3090 as it wrote it: a 190 g bar 18.4 cm long that a Panda's drive
+#: squeezes at 15 N at most, too little to hold it level by its end.
+HEAVY_BAR = """\
+# Drawn by fsvla.validate.sampler from seed 3090.
+
+scenario sampled_3090_handover_dual_panda
+  suite temporal
+  task handover(object=block)
+  embodiment dual_panda
+  instruction "Hand the block from the left arm to the right arm and set it on the plate."
+  horizon 40 s
+
+  object block: block(size=(3 cm, 18.4 cm, 3 cm), mass=190 g, color=orange) at (-6.5 cm, 15.7 cm) yaw 90 deg
+  object plate: plate(radius=9.5 cm) at (-18.5 cm, -16.7 cm)
+
+  require pre: aligned(left_gripper, right_gripper, within=15 cm) before grasped(block, right)
+  constrain separation(left_arm, right_arm) >= 0 cm warn 3 cm
+
+  success on(block, plate) and released(block) for 1 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg
+    L2: couple pre within 10 s, clutter 2 near block
+"""
+
+
+def test_the_giver_holds_a_bar_its_squeeze_cannot_hold_by_the_end_nearer_the_middle(
+        tmp_path: Path) -> None:
+    """Held 6.7 cm from its middle, the bar swung 64 deg down in the giver's fingers before
+    the taker came, and the hand-over failed. The giver now holds it HANDS_APART / 2 from
+    its middle, and the hand-over is a safe success."""
+    from fsvla.env import make
+    from fsvla.experts.tasks import handover as H
+
+    path = tmp_path / "heavy.fsv"
+    path.write_text(HEAVY_BAR, encoding="utf-8")
+    env = make(str(path), "L0", SEED)
+    env.reset()
+    world = World.of_env(env)
+    bar = H._Bar.of(world, "block")
+    _e, meet = H._plan_exchange(world, CAREFUL, "block", "left", "right")
+    assert float(bar.half[0]) - meet.inset == pytest.approx(0.5 * H.HANDS_APART)
+    env.close()
+    result = rollout(str(path), "careful", "L0", SEED)
+    assert result.safe_success, result.summary()

@@ -298,6 +298,26 @@ def _tilt(bar: _Bar) -> float:
     return float(np.arcsin(min(1.0, abs(float(bar.line[2])) / float(np.linalg.norm(bar.line)))))
 
 
+def _insets(world: World, obj: str, bar: _Bar, giver: str) -> tuple[float, ...]:
+    """The careful giver's insets from the object's end, the first preferred: INSETS;
+    where no force limit caps the squeeze but the most the giver's sliding fingers squeeze
+    (their drive's spring shut on the object's thickness) does not hold the object's
+    weight from turning in them held that far out (:func:`~fsvla.experts.skills.
+    holdable_lever`), first nearer the middle, HANDS_APART / 2 from it, the taker as far
+    on the other side (a 190 g bar held by its end in a Panda hand swung 64 deg down
+    before the taker came). Under a force limit the giver keeps the end and the taker
+    takes the object nearer the middle (:func:`_take_offset`)."""
+    out = float(bar.half[0]) - INSETS[0]
+    middle = 0.5 * HANDS_APART
+    if out <= middle + 0.01 or not world.fingers_slide(giver) \
+            or grip_force_cap(world, obj) is not None:
+        return INSETS
+    squeeze = world.gripper_stiffness(giver) * float(bar.half[1])
+    if holdable_lever(world, obj, squeeze) >= out:
+        return INSETS
+    return (float(bar.half[0]) - middle, *INSETS)
+
+
 def _take_offset(world: World, obj: str, bar: _Bar, inset: float) -> float:
     """How far from the middle (m) the careful taker takes a long object the giver holds
     ``inset`` from its other end: as far as the giver, unless a force limit caps its
@@ -326,14 +346,15 @@ def _plan_exchange(world: World, style: Style, obj: str, giver: str,
     meetings = _meeting_options(world, style, obj, giver, taker)
     if not style.avoid_hazards:  # the taker's point is chosen once the giver holds it out
         return ends[0], _Exchange(meetings[0], INSETS[0], 0.0, ABOVE[0])
-    take_at = {inset: _take_offset(world, obj, bar, inset) for inset in INSETS}
-    first = (ends[0], _Exchange(meetings[0], INSETS[0], take_at[INSETS[0]], ABOVE[0]))
+    insets = _insets(world, obj, bar, giver)
+    take_at = {inset: _take_offset(world, obj, bar, inset) for inset in insets}
+    first = (ends[0], _Exchange(meetings[0], insets[0], take_at[insets[0]], ABOVE[0]))
     gap = ArmGap(world, giver, taker)
     if not gap.watched:
         return first
     best, best_margin = first, float("-inf")
     lift = np.array([0.0, 0.0, 0.3 * bar.half[2]])
-    for inset in INSETS:
+    for inset in insets:
         for e in ends:
             grip = top_down_grasp(world, giver, bar.centre + e * (bar.half[0] - inset) * bar.along
                                   + lift, bar.across, 2 * float(bar.half[1])).pose
