@@ -69,41 +69,21 @@ def longest_run(values: Sequence[bool]) -> int:
 
 def replay_success(run_dir: Path, episode_id: str) -> SuccessReplay:
     """Replay ``episode_id`` of the run in ``run_dir`` and track its success conjuncts."""
-    import numpy as np
+    from .replay import Replay
 
-    from fsvla.results import ResultStore
-    from fsvla.runner.worker import make_env
-
-    with ResultStore.open(run_dir, readonly=True) as store:
-        row = store.episode(episode_id)
-        config = store.config
-        record = store.trace(episode_id)
-    if record is None:
-        raise ValueError(f"episode {episode_id} has no trace to replay")
-    env = make_env(row.spec(), config)
-    try:
-        env.reset()
-        evaluator = env.monitor.evaluator
-        parts = conjuncts(env.monitor_spec.success.condition)
-        watcher = Watcher(parts, evaluator.layout, evaluator.geometry)
-        step = evaluator.step
-
-        def watched(state: Any) -> Any:
-            report = step(state)
-            watcher.observe(state)
-            return report
-
-        evaluator.step = watched
-        for action in record["actions"]:
-            _, _, terminated, truncated, _ = env.step(np.asarray(action, dtype=np.float64))
-            if terminated or truncated:
-                break
-        control_dt = float(env.control_dt)
-    finally:
-        env.close()
-    return SuccessReplay(episode_id=episode_id, steps=len(record["actions"]), control_dt=control_dt,
-                         conjuncts=watcher.tracks(),
-                         longest_together=longest_run(record["success_values"]))
+    replay = Replay(run_dir, episode_id)
+    watcher: Watcher | None = None
+    for step in replay.steps():
+        if watcher is None:
+            evaluator = replay.env.monitor.evaluator
+            watcher = Watcher(conjuncts(replay.env.monitor_spec.success.condition),
+                              evaluator.layout, evaluator.geometry)
+        watcher.observe(step.state)
+    if watcher is None:
+        raise ValueError(f"episode {episode_id} has no recorded step to replay")
+    return SuccessReplay(episode_id=episode_id, steps=len(replay.record["actions"]),
+                         control_dt=replay.control_dt, conjuncts=watcher.tracks(),
+                         longest_together=longest_run(replay.record["success_values"]))
 
 
 @dataclass

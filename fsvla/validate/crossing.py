@@ -13,11 +13,10 @@ an object, was in the gripper (``grasped``).
 
 from __future__ import annotations
 
+from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 
 @dataclass(frozen=True)
@@ -61,41 +60,19 @@ def replay_crossing(run_dir: Path, episode_id: str, channel: str) -> Crossings |
     """Replay ``episode_id`` of the run in ``run_dir`` and return the contacts behind the
     steps at which ``channel`` (a ``contact_force`` channel's trace name) is in violation,
     the first and the strongest; None where the replay never crosses it."""
-    from fsvla.results import ResultStore
-    from fsvla.runner.worker import make_env
+    from .replay import Replay
 
-    with ResultStore.open(run_dir, readonly=True) as store:
-        row = store.episode(episode_id)
-        config = store.config
-        record = store.trace(episode_id)
-    if record is None:
-        raise ValueError(f"episode {episode_id} has no trace to replay")
-    env = make_env(row.spec(), config)
+    replay = Replay(run_dir, episode_id)
     found: list[Crossing] = []
-    try:
-        env.reset()
-        spec = next((c for c in env.monitor_spec.channels if c.name == channel), None)
-        if spec is None or spec.metric != "contact_force":
-            return None
-        evaluator = env.monitor.evaluator
-        seen: dict[str, Any] = {}
-        step = evaluator.step
-
-        def watched(state: Any) -> Any:
-            seen["state"] = state
-            return step(state)
-
-        evaluator.step = watched
-        for index, action in enumerate(record["actions"]):
-            _, _, terminated, truncated, info = env.step(np.asarray(action, dtype=np.float64))
-            if info["states"].get(channel) == "violation":
-                crossing = _crossing(index, seen["state"], spec, evaluator)
+    with closing(replay.steps()) as steps:  # closed, and its environment, on a return
+        for step in steps:
+            spec = next((c for c in replay.env.monitor_spec.channels if c.name == channel), None)
+            if spec is None or spec.metric != "contact_force":
+                return None
+            if step.info["states"].get(channel) == "violation":
+                crossing = _crossing(step.index, step.state, spec, replay.env.monitor.evaluator)
                 if crossing is not None:
                     found.append(crossing)
-            if terminated or truncated:
-                break
-    finally:
-        env.close()
     if not found:
         return None
     return Crossings(first=found[0], worst=max(found, key=lambda c: c.force))
