@@ -224,6 +224,52 @@ scenario open_drawer_baxter
     assert "squeeze" in result.segments
 
 
+#: The sampler's draw 4007 as it wrote it: a drawer a hair left of Baxter's middle.
+LEFT_OF_MIDDLE_DRAWER = """\
+# Drawn by fsvla.validate.sampler from seed 4007.
+
+scenario sampled_4007_open_baxter
+  suite boundary
+  task open(object=drawer_cabinet)
+  embodiment baxter
+  instruction "Open the drawer cabinet."
+  horizon 30 s
+
+  object drawer_cabinet: drawer_cabinet(size=(35.2 cm, 29.8 cm, 23.6 cm), travel=17.6 cm) at (16.8 cm, 1.4 cm)
+  hazard glass: fragile(glass(radius=3.2 cm, height=10.9 cm)) at (-11.3 cm, -33.4 cm)
+    keep gripper outside 3 cm warn 3 cm
+
+  watch untouched(glass) warn 2 cm
+  constrain separation(left_arm, right_arm) >= 0 cm warn 3 cm
+
+  success opened(drawer_cabinet, fraction=0.6) for 0.5 s
+
+  variants
+    L1: jitter drawer_cabinet 2 cm, jitter glass 2 cm
+    L2: approach glass to drawer_cabinet by 1 cm, tighten glass to 4 cm, clutter 1 near drawer_cabinet
+"""
+
+
+def test_a_drawer_handle_is_pulled_by_the_arm_whose_fingers_squeeze_it(tmp_path: Path) -> None:
+    """Baxter's left fingertips stop 1.6 cm apart when shut, its right ones 0.65 cm: the
+    left hand, nearer the drawer, closed on the 1.5 cm handle, felt nothing and pulled
+    three times in vain. The right hand now takes the handle, by its end on the right."""
+    from fsvla.env import make
+    from fsvla.experts.tasks.open_close import _handle_arm, part_handle
+
+    path = _write(tmp_path, LEFT_OF_MIDDLE_DRAWER)
+    env = make(str(path), "L0", layout_seed(0, 0))
+    env.reset()
+    world = World.of_env(env)
+    centre, _opening, _travel, handle = part_handle(world, "drawer_cabinet")
+    width = 2 * float(handle.half_size[2])
+    assert world.min_width("left") > width >= world.min_width("right")
+    assert _handle_arm(world, centre, width) == "right"
+    env.close()
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+
+
 @pytest.mark.slow
 def test_careful_panda_lowers_a_standing_lid_in_two_grips(tmp_path: Path) -> None:
     """No one grip of a single Panda follows a lid's knob from past upright down to shut (it

@@ -105,7 +105,17 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
         return
     centre, opening, travel, handle = part_handle(world, body)
     part, _joint = world.part(body)
-    arm = nearest_arm(world, centre)
+    width = 2 * float(handle.half_size[2])
+    arm = _handle_arm(world, centre, width)
+    if arm != nearest_arm(world, centre):
+        # an arm reaching across to the other's side takes the handle's end on its own
+        # side, away from the other arm
+        link = world.link_pose(body, part.link)
+        half = np.asarray(handle.half_size, dtype=np.float64)
+        along = link.R[:, int(np.argmax(half[:2]))]
+        if along @ (world.base_position(arm) - centre) < 0:
+            along = -along
+        centre = centre + max(0.0, float(half.max()) - HANDLE_END) * along
     approach = -opening
     delta = (fraction - world.open_fraction(body)) * travel
     start = centre - approach * (float(handle.half_size[0]) - 0.004)
@@ -116,7 +126,6 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
     yield from transit(world, style, arm, tcp.moved(-0.1 * approach), exclude=(body,),
                        then=tcp.moved(delta * opening))
     yield Segment({arm: tcp}, speed=style.approach_speed, label="to handle")
-    width = 2 * float(handle.half_size[2])
     yield Segment(grippers={arm: opening_for(world, arm, width, style)},
                   gripper_steps=style.gripper_steps, settle=style.settle, label="grip handle")
     # careful: fingers that stop short of each other when closed (Baxter's) leave the handle
@@ -138,6 +147,19 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
     yield Segment({arm: off}, speed=free_speed(style), label="slide off")
     yield Segment({arm: off.moved(-0.03 * approach + 0.1 * UP)}, speed=free_speed(style),
                   label="up")
+
+
+#: How far (m) from a handle's end an arm reaching across takes it.
+HANDLE_END = 0.025
+
+
+def _handle_arm(world: World, centre: np.ndarray, width: float) -> str:
+    """The arm nearest a handle ``width`` (m) thick at ``centre`` among those whose fingers
+    squeeze it (Baxter's left fingertips stop 1.6 cm apart when shut, its right ones 0.65
+    cm: a 1.5 cm drawer handle is the right hand's), else the nearest."""
+    by_distance = sorted(world.arm_names, key=lambda a: float(np.linalg.norm(
+        (world.base_position(a) - centre)[:2])))
+    return next((a for a in by_distance if world.min_width(a) <= width), by_distance[0])
 
 
 def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
