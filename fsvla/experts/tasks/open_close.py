@@ -125,7 +125,10 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
     # the IK branch that can still reach the handle where the pull ends
     yield from transit(world, style, arm, tcp.moved(-0.1 * approach), exclude=(body,),
                        then=tcp.moved(delta * opening))
-    yield Segment({arm: tcp}, speed=style.approach_speed, label="to handle")
+    # careful: a move-until-contact (far out, a Panda's hand sagged below its command and
+    # drove into the cabinet's front at 2 kN on its way in)
+    guards = (Guard(arm, push_force(world, arm, body), body),) if style.avoid_hazards else ()
+    yield Segment({arm: tcp}, speed=style.approach_speed, label="to handle", guards=guards)
     yield Segment(grippers={arm: opening_for(world, arm, width, style)},
                   gripper_steps=style.gripper_steps, settle=style.settle, label="grip handle")
     # careful: fingers that stop short of each other when closed (Baxter's) leave the handle
