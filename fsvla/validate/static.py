@@ -11,7 +11,8 @@ canonical (L0, seed 0) layout:
   where the part starts.
 * **FSV702 gripper** — an object the task grasps (pick_place, lift, insert, pour, stack,
   handover) must have a part the gripper can close around: some extent of some collision
-  piece (a mug's handle, a bowl's wall, a block's side) no wider than the gripper opens,
+  piece across two faces no other piece covers (a mug's handle, a block's side, a bowl's
+  wall across its thickness) no wider than the gripper opens,
   and, for fingers that stop apart when shut (Baxter's), a few millimetres wider than the
   gap they leave (of some arm; of both arms for a handover).
 * **FSV703 weight** — a ``contact_force`` limit on a robot part or on the object the task
@@ -251,6 +252,71 @@ def piece_widths(shape: Shape) -> tuple[float, ...]:
     return tuple(float(v) for v in vertices.max(axis=0) - vertices.min(axis=0))
 
 
+#: How far (m) beyond a collision piece's face :func:`graspable_widths` looks for another
+#: piece of the object covering that face.
+FACE_PROBE = 0.002
+
+
+def graspable_widths(asset: RigidAsset) -> list[float]:
+    """The extents (m) fingers could close across: of each collision piece, along each of
+    its own axes (:func:`piece_widths`) whose two faces no other piece of the object covers
+    (a bowl's wall segment only across its thickness: its ends meet the next segments, its
+    foot the base); every piece's extents where that leaves none."""
+    shapes = list(asset.collision)
+    found = []
+    for i, shape in enumerate(shapes):
+        others = shapes[:i] + shapes[i + 1:]
+        for width, faces in _axes(shape):
+            if not any(_inside(other, point) for other in others for point in faces):
+                found.append(width)
+    return found or [w for shape in shapes for w in piece_widths(shape)]
+
+
+def _frame(shape: Shape) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    from fsvla.compiler.pose import quat_to_matrix
+
+    return (np.asarray(shape.pose.position, dtype=np.float64),
+            quat_to_matrix(np.asarray(shape.pose.quaternion, dtype=np.float64)))
+
+
+def _axes(shape: Shape) -> list[tuple[float, tuple[NDArray[np.float64], ...]]]:
+    """(extent, a point just outside each of the two faces across it) per axis of a piece,
+    in the object's frame."""
+    centre, R = _frame(shape)
+    if shape.type == "box":
+        halves = [(float(h), R[:, k]) for k, h in enumerate(shape.half_size)]
+    elif shape.type == "cylinder":
+        halves = [(float(shape.radius), R[:, 0]), (float(shape.half_length), R[:, 2])]
+    elif shape.type in ("sphere", "capsule"):
+        halves = [(float(shape.radius), R[:, 0])]
+    else:
+        vertices = shape_vertices(shape) @ R.T + centre
+        lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+        centre = 0.5 * (lo + hi)
+        halves = [(float(0.5 * (hi - lo)[k]), np.eye(3)[k]) for k in range(3)]
+    return [(2.0 * h, (centre + (h + FACE_PROBE) * axis, centre - (h + FACE_PROBE) * axis))
+            for h, axis in halves]
+
+
+def _inside(shape: Shape, point: NDArray[np.float64]) -> bool:
+    """Whether ``point`` (the object's frame) lies inside the piece, give or take 0.1 mm."""
+    centre, R = _frame(shape)
+    local = R.T @ (point - centre)
+    tol = 1e-4
+    if shape.type == "box":
+        return bool(np.all(np.abs(local) <= np.asarray(shape.half_size) + tol))
+    if shape.type == "cylinder":
+        return bool(np.hypot(local[0], local[1]) <= shape.radius + tol
+                    and abs(local[2]) <= shape.half_length + tol)
+    if shape.type == "sphere":
+        return bool(np.linalg.norm(local) <= shape.radius + tol)
+    if shape.type == "capsule":
+        z = float(np.clip(local[2], -shape.half_length, shape.half_length))
+        return bool(np.linalg.norm(local - np.array([0.0, 0.0, z])) <= shape.radius + tol)
+    vertices = shape_vertices(shape)
+    return bool(np.all(local >= vertices.min(axis=0) - tol) and np.all(local <= vertices.max(axis=0) + tol))
+
+
 def gripper_findings(layout: Layout) -> list[Diagnostic]:
     scenario = layout.scenario
     name = layout.role("object")
@@ -264,7 +330,7 @@ def gripper_findings(layout: Layout) -> list[Diagnostic]:
     from .robots import robot_model
 
     model = robot_model(layout.scene.embodiment)
-    widths = [w for shape in body.asset.collision for w in piece_widths(shape)]
+    widths = graspable_widths(body.asset)
 
     def spans(arm: str) -> tuple[float, float]:
         """The widths (m) the arm's fingers squeeze: from a little over what its shut

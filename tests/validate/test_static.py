@@ -177,6 +177,32 @@ def test_an_object_thinner_than_the_shut_fingers(tmp_path: Path) -> None:
     assert "(2 cm)" in handed.message
 
 
+def test_a_bowl_is_held_only_across_its_wall(tmp_path: Path) -> None:
+    """A bowl's wall segments meet each other at their ends and the base at their feet:
+    fingers close only across the wall's thickness, which Baxter's shut fingers leave
+    loose (the experts refuse it: "no grasp of `bowl`")."""
+    from fsvla.compiler.assets.registry import build_asset
+
+    from fsvla.validate.static import graspable_widths, piece_widths
+
+    bowl = build_asset("bowl", {"radius": 0.063, "height": 0.065})
+    walls = [shape for shape in bowl.collision if shape.name.startswith("wall")]
+    assert walls and all(max(piece_widths(w)) > 0.02 for w in walls)  # 2.9 cm along the wall
+    assert all(w < 0.01 or w > 0.05 for w in graspable_widths(bowl))
+    path = write(tmp_path, "bowl_baxter", """
+  object bowl: bowl(radius=6.3 cm, height=6.5 cm) at (3.7 cm, -8.1 cm)
+  success lifted(bowl)
+""", task="lift(bowl)", embodiment="baxter")
+    found = only(findings(path)[1], "FSV702")
+    assert found.message.startswith("`bowl` has no part the gripper of arm `right` of baxter closes on")
+    assert found.span.line == 7
+    panda = write(tmp_path, "bowl_panda", """
+  object bowl: bowl(radius=6.3 cm, height=6.5 cm) at (3.7 cm, 8.1 cm)
+  success lifted(bowl)
+""", task="lift(bowl)")
+    assert [d for d in findings(panda)[1] if d.code == "FSV702"] == []
+
+
 def test_the_shut_gap_is_measured_on_the_fingers() -> None:
     gaps = {name: [robot_model(load_embodiment(name)).shut_gap(arm)
                    for arm in robot_model(load_embodiment(name)).arms]
