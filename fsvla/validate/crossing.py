@@ -3,12 +3,14 @@
 A recorded episode keeps each channel's margins, not the contacts behind them. To say
 whether a ``contact_force(bottle) <= 17 N`` limit was crossed by the fingers' squeeze or by
 the bottle landing on the table after it slipped out of them, :func:`replay_crossing`
-replays the episode's recorded actions in a fresh environment (as ``fsvla replay`` does:
-the same layout and physics, bit for bit) up to the first step at which the channel is in
-violation, and reads the monitor's own world state there: the largest contact force
-between one of the channel's subjects and anything else (per pair, the largest over the
-step's physics substeps, as the channel measures it), and whether the subject, if it is
-an object, was in the gripper (``grasped``).
+replays the episode's recorded actions in a fresh environment (:class:`~.replay.Replay`:
+the same layout and physics, bit for bit) and, at each step at which the channel is in
+violation, reads the monitor's own world state: the strongest contact on one of the
+channel's subjects (per pair, the largest over the step's physics substeps, as the channel
+measures it; or a free body's net contact force, from its change of speed, which no single
+pair carries: a knock, with what it touched at the step's end), and whether the subject,
+if it is an object, was in the gripper (``grasped``). It keeps the first such step and the
+hardest.
 """
 
 from __future__ import annotations
