@@ -18,7 +18,8 @@ Names are the scene spec's (bodies, articulated bodies' links and joints, zones,
 cameras). Poses are in the world (table) frame, quaternions (w, x, y, z) as everywhere in
 fsvla (``fsvla.compiler.pose``). A pose read is anything with ``p`` and ``q``
 (:class:`PoseReading`), in whatever float dtype the simulator keeps, so arithmetic on it is
-the simulator's own numbers; :class:`WorldPose` is the plain one to build.
+the simulator's own numbers; :class:`WorldPose` is the plain one to build. :func:`pad_gap`
+is the one measure of a gripper's shut fingers both sides compute on their hulls.
 """
 
 from __future__ import annotations
@@ -330,5 +331,24 @@ class SceneAppearance(Protocol):
         ...
 
 
+def pad_gap(fingers: Sequence[NDArray[np.float64]], tcp: NDArray[np.float64],
+            across: NDArray[np.float64], back: NDArray[np.float64], depth: float) -> float:
+    """How far apart (m) the fingers' pads are across the closing axis ``across`` (unit):
+    of each finger's hull ``fingers`` (world points), what lies within ``depth`` behind the
+    TCP at ``tcp`` (``back``: unit, from the TCP back into the hand), each finger on the side
+    of the TCP its pad lies on; 0 where the pads meet or one side has none."""
+    sides: dict[bool, list[float]] = {True: [], False: []}
+    for points in fingers:
+        rel = np.asarray(points, dtype=np.float64) - tcp
+        pads = rel[rel @ back < depth] @ across
+        if len(pads):
+            positive = float(np.mean(pads)) > 0.0
+            sides[positive].append(float(np.min(pads)) if positive else float(np.max(pads)))
+    if not sides[True] or not sides[False]:
+        return 0.0
+    return max(0.0, min(sides[True]) - max(sides[False]))
+
+
 __all__ = ["ArmModel", "Camera", "Color", "IKResult", "Light", "Material", "MonitoredScene",
-           "PoseReading", "SceneAppearance", "SceneState", "StepProbe", "Undo", "WorldPose"]
+           "PoseReading", "SceneAppearance", "SceneState", "StepProbe", "Undo", "WorldPose",
+           "pad_gap"]

@@ -21,7 +21,7 @@ from fsvla.compiler.pose import AXES, quat_to_matrix, rotation_angle, rotation_b
 from fsvla.compiler.scene import SceneSpec
 from fsvla.dsl.models import Scenario
 from fsvla.embodiments.spec import ArmSpec
-from fsvla.world import ArmModel, SceneState
+from fsvla.world import ArmModel, SceneState, pad_gap
 
 from .motion import Pose
 
@@ -279,20 +279,9 @@ class World:
         if len(fingers) < 2 or not self.fingers_slide(arm):
             return 0.0
         tcp = self.current_pose(arm)
-        across, back = tcp.R @ self.finger_axis(arm), -(tcp.R @ self.approach_axis(arm))
-        sides: dict[bool, list[float]] = {True: [], False: []}
-        for link in fingers:
-            points = self.link_points(arm, link)
-            if points is None:
-                continue
-            rel = points - tcp.p
-            pads = rel[rel @ back < PAD_DEPTH] @ across
-            if len(pads):
-                positive = float(np.mean(pads)) > 0.0
-                sides[positive].append(float(np.min(pads) if positive else np.max(pads)))
-        if not sides[True] or not sides[False]:
-            return 0.0
-        gap = min(sides[True]) - max(sides[False])
+        hulls = [p for p in (self.link_points(arm, link) for link in fingers) if p is not None]
+        gap = pad_gap(hulls, tcp.p, tcp.R @ self.finger_axis(arm),
+                      -(tcp.R @ self.approach_axis(arm)), PAD_DEPTH)
         return max(0.0, gap - self.gripper_opening(arm) * self.travel(arm))
 
     def grip_gap(self, arm: str, obj: str) -> float | None:

@@ -24,7 +24,7 @@ from fsvla.compiler.pose import (
     transform_points,
 )
 from fsvla.embodiments.spec import ArmSpec
-from fsvla.world import IKResult
+from fsvla.world import IKResult, pad_gap
 
 from .robot import LoadedArm
 
@@ -100,20 +100,13 @@ class ArmKinematics:
         across = (points[0] - points[1]) / np.linalg.norm(points[0] - points[1])
         tcp, closed = self._fingers_at(0.0)
         back = -(quat_to_matrix(tcp.q) @ np.asarray(AXES[self.arm.spec.approach_axis], dtype=np.float64))
-        faces: dict[bool, list[float]] = {True: [], False: []}
         links = self.arm.articulation.get_links()
+        hulls = []
         for finger, pose in zip(self.arm.finger_links, closed):
             local = self.link_vertices(next(i for i, lk in enumerate(links) if lk.name == finger.name))
-            if local is None:
-                continue
-            rel = transform_points(local, pose.p, pose.q) - np.asarray(tcp.p, dtype=np.float64)
-            pads = rel[rel @ back < depth] @ across
-            if len(pads):
-                outward = float(np.mean(pads)) > 0.0
-                faces[outward].append(float(np.min(pads)) if outward else float(np.max(pads)))
-        if not faces[True] or not faces[False]:
-            return 0.0
-        return max(0.0, min(faces[True]) - max(faces[False]))
+            if local is not None:
+                hulls.append(transform_points(local, pose.p, pose.q))
+        return pad_gap(hulls, np.asarray(tcp.p, dtype=np.float64), across, back, depth)
 
     def _fingers_at(self, fraction: float) -> tuple[Any, list[Any]]:
         """The world TCP pose and each finger link's, the gripper open by ``fraction``."""

@@ -66,11 +66,14 @@ def replay_crossing(run_dir: Path, episode_id: str, channel: str) -> Crossings |
 
     replay = Replay(run_dir, episode_id)
     found: list[Crossing] = []
+    spec = None
     with closing(replay.steps()) as steps:  # closed, and its environment, on a return
         for step in steps:
-            spec = next((c for c in replay.env.monitor_spec.channels if c.name == channel), None)
-            if spec is None or spec.metric != "contact_force":
-                return None
+            if spec is None:  # the environment is built by the first step
+                spec = next((c for c in replay.env.monitor_spec.channels if c.name == channel),
+                            None)
+                if spec is None or spec.metric != "contact_force":
+                    return None
             if step.info["states"].get(channel) == "violation":
                 crossing = _crossing(step.index, step.state, spec, replay.env.monitor.evaluator)
                 if crossing is not None:

@@ -39,7 +39,6 @@ from fsvla.embodiments.spec import EmbodimentSpec
 #: arm's base (toward the point), negative toward it.
 APPROACH_TILTS = (0.0, 30.0, 60.0, 90.0, -30.0, -60.0)
 POSITION_TOLERANCE = 0.01  # m
-PAD_DEPTH = 0.035  # m behind the TCP within which a finger's hull counts as its pad
 ROTATION_TOLERANCE = 0.05  # rad
 
 
@@ -105,6 +104,8 @@ class RobotModel:
 
     def shut_gap(self, arm: str) -> float:
         """How far apart (m) the fingers' pads stay with the gripper shut (module doc)."""
+        from fsvla.experts.world import PAD_DEPTH
+
         return self._kinematics[arm].shut_gap(PAD_DEPTH)
 
     def _measure_opening(self, arm: str) -> float:
@@ -123,4 +124,4 @@ def robot_model(spec: EmbodimentSpec) -> RobotModel:
     return _model(spec.model_dump_json())
 
 
-__all__ = ["APPROACH_TILTS", "PAD_DEPTH", "POSITION_TOLERANCE", "ROTATION_TOLERANCE", "RobotModel", "robot_model"]
+__all__ = ["APPROACH_TILTS", "POSITION_TOLERANCE", "ROTATION_TOLERANCE", "RobotModel", "robot_model"]
