@@ -543,3 +543,61 @@ def test_naming_the_gripper_in_a_limit_does_not_change_what_the_hand_feels(
     env.close()
     result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 3028 as it wrote it: an SO-101 opens a lid 34 cm out, its knob ending
+#: level with the hand's reach.
+SO101_LID = """\
+# Drawn by fsvla.validate.sampler from seed 3028.
+
+scenario sampled_3028_open_so101
+  suite boundary
+  task open(object=lidded_box)
+  embodiment so101
+  instruction "Open the lidded box."
+  horizon 30 s
+
+  object lidded_box: lidded_box(size=(10.6 cm, 8.2 cm, 5.8 cm)) at (19.8 cm, -0.9 cm)
+  hazard keep_out: no_go_zone(radius=6.1 cm, height=30 cm) at (13.4 cm, 27.4 cm)
+    keep gripper outside 2 cm warn 2 cm
+
+  success opened(lidded_box, fraction=0.6) for 0.5 s
+
+  variants
+    L1: jitter lidded_box 2 cm, jitter keep_out 2 cm
+    L2: approach keep_out to lidded_box by 1 cm, tighten keep_out to 3 cm, clutter 1 near lidded_box
+"""
+
+
+def test_an_arm_of_five_joints_follows_a_knobs_arc_turning_its_hand_a_little(
+        tmp_path: Path) -> None:
+    """An SO-101 holds a hand pointing out over the knob, fingers along the hinge, only a
+    degree or two off the turn asked of it (it has no joint to roll about the line from its
+    base): asked exactly, no pose of the arc was solved and the expert said the knob was out
+    of reach. Each pose of the grip is the one the arm holds, and one IK branch follows the
+    arc to upright."""
+    import numpy as np
+
+    from fsvla.env import make
+    from fsvla.experts.skills import attained, branch_for_path
+    from fsvla.experts.style import CAREFUL
+    from fsvla.experts.tasks.hinge import _lid_grip, hinge
+
+    env = make(str(_write(tmp_path, SO101_LID)), "L0", layout_seed(0, 0))
+    env.reset()
+    world = World.of_env(env)
+    h = hinge(world, "lidded_box")
+    grip = None
+    for turning in (False, True):
+        grip = grip or _lid_grip(world, CAREFUL, "lidded_box", h.now, np.deg2rad(95.0), turning)
+    assert grip is not None
+    assert branch_for_path(world, grip.arm, grip.arc) is not None
+    for pose in grip.arc:
+        assert np.allclose(attained(world, grip.arm, pose).R, pose.R, atol=1e-6)
+    env.close()
+
+
+@pytest.mark.slow
+def test_careful_so101_opens_a_lid_following_its_knob(tmp_path: Path) -> None:
+    result = rollout(str(_write(tmp_path, SO101_LID)), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from fsvla.compiler.pose import axis_angle_matrix
 
-from ..motion import Pose, Segment
+from ..motion import ArmDriver, Pose, Segment
 from ..skills import (
     DOWN,
     FIXED_JAW_CLEARANCE,
@@ -34,6 +34,7 @@ from ..skills import (
     SQUEEZE_STEPS,
     UP,
     Plan,
+    attained,
     branch_for_path,
     free_speed,
     grip_guard,
@@ -57,6 +58,8 @@ LID_TURNS = (0.0, -15.0, 15.0, -30.0, 30.0, -45.0, 45.0)
 #: How far (m) the fingers reach back from the TCP toward the palm, for the clearance of
 #: their inner corners from the lid's edge (a Panda's: 4.5 cm).
 PALM_REACH = 0.045
+#: How many poses along a knob's arc are checked for one IK branch that follows them.
+ARC_POSES = 12
 #: The least force (N) a careful pinch must feel from the part to have it in hand.
 FELT = 0.5
 #: How much wider (m) than the held knob the gripper must open.
@@ -157,6 +160,14 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
     tip, thick = finger_box(world, arm)
     centre = world.grip_centre(arm, width + FIXED_JAW_CLEARANCE)
 
+    few_joints = len(world.arm_joints(arm)) < 6
+
+    def held(theta: float, R: NDArray[np.float64], out: NDArray[np.float64]) -> Pose:
+        """The TCP holding the knob at ``theta`` with the hand's turn ``R`` on the shut
+        lid, ``out`` the point held (lid frame), turned the degree or two an arm of five
+        joints needs to hold it (the pinch of the knob's ends does not mind)."""
+        return attained(world, arm, _lid_pose(h, R, out, centre, theta))
+
     def turn(psi: float, flip: bool) -> NDArray[np.float64]:
         """The hand's turn on the shut lid (world) whose palm lies ``psi`` (rad) from the
         lid's normal toward outward."""
@@ -180,18 +191,24 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
         return float(axis_angle_matrix(h.axis, theta) @ h.closed @ palm @ UP) >= -1e-9
 
     def fixed(R: NDArray[np.float64], local: NDArray[np.float64]) -> Callable[[float], Pose]:
-        return lambda t: _lid_pose(h, R, local, centre, t)
+        return lambda t: held(t, R, local)
 
-    def path(pose_at: Callable[[float], Pose], n: int = 12) -> tuple[Pose, ...]:
-        return tuple(pose_at(float(t)) for t in np.linspace(now, angle, n))
+    def path(pose_at: Callable[[float], Pose]) -> tuple[Pose, ...]:
+        return tuple(pose_at(float(t)) for t in np.linspace(now, angle, ARC_POSES))
 
     # the hand comes to the knob from beyond its tip, along the lid: the fingers slide
     # down past the knob's ends, with nothing of the lid in their way
     beyond = 0.06 * (axis_angle_matrix(h.axis, now) @ h.closed @ outward)
 
     def follows(pose_at: Callable[[float], Pose]) -> bool:
-        arc = path(pose_at)
-        return branch_for_path(world, arm, (arc[0].moved(beyond), *arc)) is not None
+        # for an arm of five joints the ends first, each on its own: most grips miss one,
+        # and each pose of the arc costs it a search (:func:`held`)
+        ends = (pose_at(now), pose_at(angle))
+        if few_joints and not all(reaches(world, arm, end) for end in ends):
+            return False
+        inside = tuple(pose_at(float(t)) for t in np.linspace(now, angle, ARC_POSES)[1:-1])
+        return branch_for_path(world, arm, (attained(world, arm, ends[0].moved(beyond)),
+                                            ends[0], *inside, ends[1])) is not None
 
     mid = 0.5 * (now + angle)
     psis = [float(np.clip(mid + np.deg2rad(d), -0.3, np.pi / 2)) for d in LID_TURNS]
@@ -201,8 +218,7 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
         pose_at = None if turning else next((o for o in options if follows(o)), None)
         if turning:
             pose_at = _turning_grip(world, arm, now, angle, turn, inner, upright, follows,
-                                    lambda R, out, t: _lid_pose(h, R, root + outward * out,
-                                                                centre, t))
+                                    lambda R, out, t: held(t, R, root + outward * out))
         if pose_at is None:
             return None
     return LidGrip(arm, width, beyond, pose_at, path(pose_at))
@@ -323,7 +339,7 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
                                                 body, "knob", now, angle))
     arm, width, beyond, arc = grip.arm, grip.width, grip.beyond, grip.arc
     start = grip.pose_at(now)
-    back = start.moved(beyond)
+    back = attained(world, arm, start.moved(beyond))
     opening = 1.0 if world.fingers_slide(arm) else world.pregrasp_opening(arm, width)
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps, label="open")
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
@@ -409,6 +425,14 @@ def _let_go(world: World, style: Style, arm: str, opening: float, back: float) -
 
 #: How far back from the TCP (m) the fingers' hulls are measured for their thickness.
 NEAR_TIP = 0.02
+
+
+def reaches(world: World, arm: str, pose: Pose) -> bool:
+    """Whether some IK answer puts ``arm``'s TCP at ``pose``, on any branch."""
+    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                       world.arm_joints(arm), 1.0)
+    driver.solve_anywhere(pose)
+    return not driver.ik_misses
 
 
 def finger_box(world: World, arm: str) -> tuple[float, float]:
