@@ -455,6 +455,15 @@ def attained(world: World, arm: str, pose: Pose) -> Pose:
     return driver.attainable(pose)
 
 
+def reaches(world: World, arm: str, pose: Pose) -> bool:
+    """Whether IK puts the arm's TCP at ``pose`` (from any start, on any branch, within the
+    limits)."""
+    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                       world.arm_joints(arm), 1.0)
+    driver.solve_anywhere(pose)
+    return not driver.ik_misses
+
+
 def attainable(world: World, arm: str, grasp: Grasp) -> Grasp:
     """``grasp`` with its pose :func:`attained`."""
     pose = attained(world, arm, grasp.pose)
@@ -849,6 +858,7 @@ __all__ = [
     "park_others",
     "pick",
     "place",
+    "reaches",
     "squeeze_until_felt",
     "top_down_grasp",
     "transit",

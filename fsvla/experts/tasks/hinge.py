@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from fsvla.compiler.pose import axis_angle_matrix
 
-from ..motion import ArmDriver, Pose, Segment
+from ..motion import Pose, Segment
 from ..skills import (
     DOWN,
     FIXED_JAW_CLEARANCE,
@@ -40,6 +40,7 @@ from ..skills import (
     grip_guard,
     nearest_arm,
     opening_for,
+    reaches,
     transit,
 )
 from ..style import Style
@@ -123,12 +124,12 @@ def _extent_along(shape, direction: NDArray[np.float64]) -> float:
 @dataclass(frozen=True)
 class LidGrip:
     """How a hand holds a lid's knob along its arc: the arm, the knob's width between the
-    fingers, the approach from beyond the knob (m, world), the TCP pose at each lid angle,
+    fingers, the TCP pose beyond the knob it comes in from, the TCP pose at each lid angle,
     and that pose at a dozen angles of the arc."""
 
     arm: str
     width: float
-    beyond: NDArray[np.float64]
+    back: Pose
     pose_at: Callable[[float], Pose]
     arc: tuple[Pose, ...]
 
@@ -193,12 +194,19 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
     def fixed(R: NDArray[np.float64], local: NDArray[np.float64]) -> Callable[[float], Pose]:
         return lambda t: held(t, R, local)
 
-    def path(pose_at: Callable[[float], Pose]) -> tuple[Pose, ...]:
-        return tuple(pose_at(float(t)) for t in np.linspace(now, angle, ARC_POSES))
-
     # the hand comes to the knob from beyond its tip, along the lid: the fingers slide
     # down past the knob's ends, with nothing of the lid in their way
     beyond = 0.06 * (axis_angle_matrix(h.axis, now) @ h.closed @ outward)
+
+    def approach(pose_at: Callable[[float], Pose],
+                 ends: tuple[Pose, Pose] | None = None) -> tuple[Pose, tuple[Pose, ...]]:
+        """The pose beyond the knob the hand comes in from, and the arc: ARC_POSES poses
+        from ``now`` to ``angle`` (``ends``: its first and last, where already made)."""
+        first, last = ends if ends is not None else (pose_at(now), pose_at(angle))
+        inside = tuple(pose_at(float(t)) for t in np.linspace(now, angle, ARC_POSES)[1:-1])
+        return attained(world, arm, first.moved(beyond)), (first, *inside, last)
+
+    followed: dict[Callable[[float], Pose], tuple[Pose, tuple[Pose, ...]]] = {}
 
     def follows(pose_at: Callable[[float], Pose]) -> bool:
         # for an arm of five joints the ends first, each on its own: most grips miss one,
@@ -206,9 +214,11 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
         ends = (pose_at(now), pose_at(angle))
         if few_joints and not all(reaches(world, arm, end) for end in ends):
             return False
-        inside = tuple(pose_at(float(t)) for t in np.linspace(now, angle, ARC_POSES)[1:-1])
-        return branch_for_path(world, arm, (attained(world, arm, ends[0].moved(beyond)),
-                                            ends[0], *inside, ends[1])) is not None
+        back, arc = approach(pose_at, ends)
+        if branch_for_path(world, arm, (back, *arc)) is None:
+            return False
+        followed[pose_at] = (back, arc)  # the grip made of it need not search them again
+        return True
 
     mid = 0.5 * (now + angle)
     psis = [float(np.clip(mid + np.deg2rad(d), -0.3, np.pi / 2)) for d in LID_TURNS]
@@ -221,7 +231,8 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
                                     lambda R, out, t: held(t, R, root + outward * out))
         if pose_at is None:
             return None
-    return LidGrip(arm, width, beyond, pose_at, path(pose_at))
+    back, arc = followed[pose_at] if pose_at in followed else approach(pose_at)
+    return LidGrip(arm, width, back, pose_at, arc)
 
 
 #: The hand's turns on a lid (deg, from the lid's normal toward the knob's side) a turning
@@ -337,9 +348,8 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     if grip is None:
         raise NotImplementedError(_out_of_reach(nearest_arm(world, world.body_pose(body).p),
                                                 body, "knob", now, angle))
-    arm, width, beyond, arc = grip.arm, grip.width, grip.beyond, grip.arc
-    start = grip.pose_at(now)
-    back = attained(world, arm, start.moved(beyond))
+    arm, width, back, arc = grip.arm, grip.width, grip.back, grip.arc
+    start = arc[0]
     opening = 1.0 if world.fingers_slide(arm) else world.pregrasp_opening(arm, width)
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps, label="open")
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
@@ -425,14 +435,6 @@ def _let_go(world: World, style: Style, arm: str, opening: float, back: float) -
 
 #: How far back from the TCP (m) the fingers' hulls are measured for their thickness.
 NEAR_TIP = 0.02
-
-
-def reaches(world: World, arm: str, pose: Pose) -> bool:
-    """Whether some IK answer puts ``arm``'s TCP at ``pose``, on any branch."""
-    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
-                       world.arm_joints(arm), 1.0)
-    driver.solve_anywhere(pose)
-    return not driver.ik_misses
 
 
 def finger_box(world: World, arm: str) -> tuple[float, float]:

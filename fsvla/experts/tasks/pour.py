@@ -9,7 +9,7 @@ import numpy as np
 from fsvla.compiler.pose import axis_angle_matrix, rotation_angle, slerp
 
 from .. import grasps
-from ..motion import ArmDriver, Pose, Segment
+from ..motion import Pose, Segment
 from ..skills import (
     UP,
     Grasp,
@@ -24,6 +24,7 @@ from ..skills import (
     load_reach,
     pick,
     place,
+    reaches,
     transit,
 )
 from ..style import Style
@@ -68,7 +69,7 @@ def plan_pour(world: World, style: Style, roles: dict[str, str], arm: str | None
     # (Baxter tipping a mug sideways far out to its side swung its elbow across in one
     # step, 14 cm off the command)
     pour = None
-    if style.avoid_hazards and not _reaches(world, arm, ways[0]):
+    if style.avoid_hazards and not reaches(world, arm, ways[0]):
         # the first way ends beyond the arm's reach: another one it follows
         pour = _followed(world, arm, obj, target, over, ways, load)
     lo, hi = world.bounds(obj)
@@ -132,14 +133,6 @@ def _pour_poses(world: World, style: Style, arm: str, obj: str, target: str, tcp
 def _least_tilt(world: World, obj: str) -> float:
     """The least tilt (deg) a pour of ``obj`` goes to: what the task asks, TILT_SPARE past."""
     return float(np.degrees(required_tilt(world, obj))) + TILT_SPARE
-
-
-def _reaches(world: World, arm: str, pose: Pose) -> bool:
-    """Whether IK puts the arm's TCP at ``pose`` (from any start, within the limits)."""
-    driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
-                       world.arm_joints(arm), 1.0)
-    driver.solve_anywhere(pose)
-    return not driver.ik_misses
 
 
 def _followed(world: World, arm: str, obj: str, target: str, over: Pose, ways: list[Pose],
