@@ -601,3 +601,35 @@ def test_an_arm_of_five_joints_follows_a_knobs_arc_turning_its_hand_a_little(
 def test_careful_so101_opens_a_lid_following_its_knob(tmp_path: Path) -> None:
     result = rollout(str(_write(tmp_path, SO101_LID)), "careful", "L0", layout_seed(0, 0))
     assert result.safe_success, result.summary()
+
+
+#: The sampler's draw 5008 as it wrote it: the SO-101's pinch at the style's 8 N felt the
+#: knob, the lid rose 8 deg, and the knob slipped out of the jaws.
+SO101_LID_SLIPPING = """\
+# Drawn by fsvla.validate.sampler from seed 5008.
+
+scenario sampled_5008_open_so101
+  suite boundary
+  task open(object=lidded_box)
+  embodiment so101
+  instruction "Open the lidded box."
+  horizon 30 s
+
+  object lidded_box: lidded_box(size=(10.9 cm, 7.9 cm, 5.8 cm)) at (19.8 cm, -0.9 cm)
+  hazard keep_out: no_go_zone(radius=5.3 cm, height=30 cm) at (32.5 cm, 24.4 cm)
+    keep gripper outside 3 cm warn 2 cm
+
+  success opened(lidded_box, fraction=0.6) for 0.5 s
+
+  variants
+    L1: jitter lidded_box 2 cm, jitter keep_out 2 cm
+    L2: approach keep_out to lidded_box by 1 cm, tighten keep_out to 4 cm, clutter 1 near lidded_box
+"""
+
+
+@pytest.mark.slow
+def test_careful_so101_holds_a_lids_knob_up_past_upright(tmp_path: Path) -> None:
+    result = rollout(str(_write(tmp_path, SO101_LID_SLIPPING)), "careful", "L0",
+                     layout_seed(0, 0))
+    assert result.safe_success, result.summary()
+    assert "swing lid" in result.segments

@@ -354,7 +354,9 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps, label="open")
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to knob")
-    yield from pinch(world, style, arm, body, width)
+    wanted = knob_squeeze(world, style, arm)
+    yield from pinch(world, style, arm, body, width, wanted,
+                     felt=0.8 if wanted is None else KNOB_FELT)
     if style.avoid_hazards and world.hand_force(arm, body, fingers=True) < FELT:
         if missed is not None:
             yield from _let_go(world, style, arm, opening, 0.05)
@@ -526,6 +528,23 @@ def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
     yield from _let_go(world, style, arm, opening, 0.06)
 
 
+#: The squeeze (N) a careful pinch of a knob by a jaw on a hinge wants (the style's 8 N
+#: let an SO-101's knob slip out of its jaws as the lid's weight came onto them, the lid
+#: 8 deg up), and the share of it at which the pinch closes no further: the swinging jaw
+#: alone presses the knob against the hinge, and closing on from there (or pinching at 16
+#: N or more) brings the fixed jaw onto the knob with a jump of 60-110 N.
+KNOB_SQUEEZE = 12.0
+KNOB_FELT = 0.5
+
+
+def knob_squeeze(world: World, style: Style, arm: str) -> float | None:
+    """The squeeze (N) a careful pinch of a knob by ``arm`` wants: KNOB_SQUEEZE for a jaw on
+    a hinge, else (None) the style's grip force."""
+    if style.grip_force is None or world.moving_jaw(arm) is None:
+        return None
+    return max(style.grip_force, KNOB_SQUEEZE)
+
+
 def pinch_force(world: World, style: Style, body: str, wanted: float | None = None) -> float:
     """The careful squeeze on a part of ``body``: ``wanted`` (default: the style's grip
     force), at most half of a contact-force limit on the hand or the body and out of its
@@ -536,10 +555,10 @@ def pinch_force(world: World, style: Style, body: str, wanted: float | None = No
 
 
 def pinch(world: World, style: Style, arm: str, body: str, width: float,
-          wanted: float | None = None) -> Plan:
+          wanted: float | None = None, felt: float = 0.8) -> Plan:
     """Close the fingers on a part ``width`` across: careful, quickly to just short of it,
     then slowly with the hand's force guarded at :func:`pinch_force` (of ``wanted``),
-    closing on by small steps until the squeeze is felt; careless, shut at once."""
+    closing on by small steps until ``felt`` of it is felt; careless, shut at once."""
     force = pinch_force(world, style, body, wanted)
     target = opening_for(world, arm, width, replace(style, grip_force=force)
                          if style.grip_force is not None else style)
@@ -553,20 +572,20 @@ def pinch(world: World, style: Style, arm: str, body: str, width: float,
     steps = max(2 * style.gripper_steps, int(np.ceil((near - target) / SLOW_CLOSE)))
     yield Segment(grippers={arm: target}, gripper_steps=steps, settle=style.settle,
                   guards=(guard,), label="pinch")
-    yield from squeeze_on(world, style, arm, body, force)
+    yield from squeeze_on(world, style, arm, body, force, felt=felt)
 
 
 def squeeze_on(world: World, style: Style, arm: str, body: str, force: float,
-               step: float = 2 * SLOW_CLOSE) -> Plan:
+               step: float = 2 * SLOW_CLOSE, felt: float = 0.8) -> Plan:
     """Careful: close on by ``step`` of the gripper's range at a time, guarded, until the
-    hand feels 80 % of ``force`` from ``body`` (fingers that stop short of each other when
-    closed, as Baxter's, leave a handle loose at the width model's opening)."""
+    hand feels ``felt`` of ``force`` from ``body`` (fingers that stop short of each other
+    when closed, as Baxter's, leave a handle loose at the width model's opening)."""
     if not style.avoid_hazards:
         return
     guard = grip_guard(world, arm, force, body)
     goal = world.gripper_opening(arm)
     for _ in range(SQUEEZE_STEPS):
-        if world.hand_force(arm, body, fingers=True) >= 0.8 * force or goal <= 0.0:
+        if world.hand_force(arm, body, fingers=True) >= felt * force or goal <= 0.0:
             break
         goal = max(0.0, goal - step)
         yield Segment(grippers={arm: goal}, gripper_steps=2, settle=2, guards=(guard,),
