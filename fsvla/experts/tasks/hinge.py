@@ -354,9 +354,7 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps, label="open")
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to knob")
-    wanted = knob_squeeze(world, style, arm)
-    yield from pinch(world, style, arm, body, width, wanted,
-                     felt=0.8 if wanted is None else KNOB_FELT)
+    yield from pinch(world, style, arm, body, width, *knob_pinch(world, style, arm))
     if style.avoid_hazards and world.hand_force(arm, body, fingers=True) < FELT:
         if missed is not None:
             yield from _let_go(world, style, arm, opening, 0.05)
@@ -535,14 +533,17 @@ def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
 #: N or more) brings the fixed jaw onto the knob with a jump of 60-110 N.
 KNOB_SQUEEZE = 12.0
 KNOB_FELT = 0.5
+#: The share of its squeeze at which a careful pinch otherwise closes no further.
+PINCH_FELT = 0.8
 
 
-def knob_squeeze(world: World, style: Style, arm: str) -> float | None:
-    """The squeeze (N) a careful pinch of a knob by ``arm`` wants: KNOB_SQUEEZE for a jaw on
-    a hinge, else (None) the style's grip force."""
+def knob_pinch(world: World, style: Style, arm: str) -> tuple[float | None, float]:
+    """The squeeze (N) a careful pinch of a knob by ``arm`` wants and the share of it felt
+    at which it closes no further: KNOB_SQUEEZE and KNOB_FELT for a jaw on a hinge, else
+    the style's grip force (None) and PINCH_FELT."""
     if style.grip_force is None or world.moving_jaw(arm) is None:
-        return None
-    return max(style.grip_force, KNOB_SQUEEZE)
+        return None, PINCH_FELT
+    return max(style.grip_force, KNOB_SQUEEZE), KNOB_FELT
 
 
 def pinch_force(world: World, style: Style, body: str, wanted: float | None = None) -> float:
@@ -555,7 +556,7 @@ def pinch_force(world: World, style: Style, body: str, wanted: float | None = No
 
 
 def pinch(world: World, style: Style, arm: str, body: str, width: float,
-          wanted: float | None = None, felt: float = 0.8) -> Plan:
+          wanted: float | None = None, felt: float = PINCH_FELT) -> Plan:
     """Close the fingers on a part ``width`` across: careful, quickly to just short of it,
     then slowly with the hand's force guarded at :func:`pinch_force` (of ``wanted``),
     closing on by small steps until ``felt`` of it is felt; careless, shut at once."""
@@ -576,7 +577,7 @@ def pinch(world: World, style: Style, arm: str, body: str, width: float,
 
 
 def squeeze_on(world: World, style: Style, arm: str, body: str, force: float,
-               step: float = 2 * SLOW_CLOSE, felt: float = 0.8) -> Plan:
+               step: float = 2 * SLOW_CLOSE, felt: float = PINCH_FELT) -> Plan:
     """Careful: close on by ``step`` of the gripper's range at a time, guarded, until the
     hand feels ``felt`` of ``force`` from ``body`` (fingers that stop short of each other
     when closed, as Baxter's, leave a handle loose at the width model's opening)."""
