@@ -167,7 +167,7 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
         """The TCP holding the knob at ``theta`` with the hand's turn ``R`` on the shut
         lid, ``out`` the point held (lid frame), turned the degree or two an arm of five
         joints needs to hold it (the pinch of the knob's ends does not mind)."""
-        return attained(world, arm, _lid_pose(h, R, out, centre, theta))
+        return attained(world, arm, lid_pose(h, R, out, centre, theta))
 
     def turn(psi: float, flip: bool) -> NDArray[np.float64]:
         """The hand's turn on the shut lid (world) whose palm lies ``psi`` (rad) from the
@@ -357,19 +357,19 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     yield from pinch(world, style, arm, body, width, *knob_pinch(world, style, arm))
     if style.avoid_hazards and world.hand_force(arm, body, fingers=True) < FELT:
         if missed is not None:
-            yield from _let_go(world, style, arm, opening, 0.05)
+            yield from let_go(world, style, arm, opening, 0.05)
             yield from missed()
             return
         raise NotImplementedError(
             f"the careful expert's fingers closed on nothing at `{body}`'s knob: the pinch "
             f"that keeps `{arm}`'s fingers clear of the lid's edge holds the knob beyond "
             f"its end (the fingers are thicker than the knob stands out)")
-    yield from _sweep(world, style, arm, grip.pose_at, now, angle, "swing lid")
+    yield from sweep(world, style, arm, grip.pose_at, now, angle, "swing lid")
     if held:  # short of upright: let go and it falls shut
         yield Segment({}, settle=round(world.scenario.horizon / world.dt), label="hold lid open")
         return
     yield Segment({}, settle=style.settle, label="hold lid")
-    yield from _let_go(world, style, arm, opening, 0.05)
+    yield from let_go(world, style, arm, opening, 0.05)
 
 
 #: Angles (deg) at which the careful expert lets a lid rest between two grips on its way
@@ -413,7 +413,7 @@ def _rests(world: World, body: str, theta: float) -> bool:
     return torque <= 0.5 * joint.friction
 
 
-def _lid_pose(h: Hinge, R_shut: NDArray[np.float64], local: NDArray[np.float64],
+def lid_pose(h: Hinge, R_shut: NDArray[np.float64], local: NDArray[np.float64],
               centre: NDArray[np.float64], theta: float) -> Pose:
     """The TCP holding the lid's point ``local`` at the angle ``theta``, the hand turned
     with the lid from ``R_shut`` (its turn when the lid is shut)."""
@@ -423,7 +423,7 @@ def _lid_pose(h: Hinge, R_shut: NDArray[np.float64], local: NDArray[np.float64],
 
 
 
-def _let_go(world: World, style: Style, arm: str, opening: float, back: float) -> Plan:
+def let_go(world: World, style: Style, arm: str, opening: float, back: float) -> Plan:
     """Open to ``opening``, back the hand off ``back`` (m) along its approach, and rise."""
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps,
                   settle=style.settle, label="let go")
@@ -521,9 +521,9 @@ def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to handle")
     yield from pinch(world, style, arm, body, width, DOOR_PINCH)
-    yield from _sweep(world, style, arm, at, h.now, angle, "swing door")
+    yield from sweep(world, style, arm, at, h.now, angle, "swing door")
     yield Segment({}, settle=style.settle, label="hold door")
-    yield from _let_go(world, style, arm, opening, 0.06)
+    yield from let_go(world, style, arm, opening, 0.06)
 
 
 #: The squeeze (N) a careful pinch of a knob by a jaw on a hinge wants (the style's 8 N
@@ -601,7 +601,7 @@ def _out_of_reach(arm: str, body: str, held: str, start: float, end: float) -> s
             f"follows the {held}'s arc within the joint limits (out of the arm's reach)")
 
 
-def _sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose],
+def sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose],
            start: float, end: float, label: str) -> Plan:
     """Careful: one smooth sweep along the arc; careless: 8° chords at approach speed."""
     if style.avoid_hazards:
@@ -613,5 +613,6 @@ def _sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose
         yield Segment({arm: pose_at(float(theta))}, speed=style.approach_speed, label=label)
 
 
-__all__ = ["Hinge", "finger_box", "hinge", "knob_pinch_fits", "lower_lid", "pinch", "pinch_force", "squeeze_on",
-           "swing_door", "swing_lid"]
+__all__ = ["FELT", "Hinge", "LidGrip", "finger_box", "hinge", "knob_pinch", "knob_pinch_fits", "let_go",
+           "lid_pose", "lower_lid", "pinch", "pinch_force", "squeeze_on", "sweep", "swing_door",
+           "swing_lid"]

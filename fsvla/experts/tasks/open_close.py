@@ -29,6 +29,7 @@ from .common import (
 )
 from .hinge import (
     has_shape,
+    hinge,
     knob_pinch_fits,
     lower_lid,
     pinch_force,
@@ -37,6 +38,7 @@ from .hinge import (
     swing_lid,
 )
 from .lid import LID_PAST_VERTICAL, lift_lid
+from .lid_tab import pull_over
 from .push_shut import push_shut
 
 
@@ -242,11 +244,8 @@ def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
         yield Segment(settle=20, label="already shut")
     elif _sliding(world, body):
         yield from push_part_closed(world, style, body)
-    elif _knob_lid(world, body) and knob_pinch_fits(world, body):
-        yield from lower_lid(world, style, body, SWUNG_SHUT * span,
-                             instead=lambda: push_shut(
-                                 world, style, body, SWUNG_SHUT * span,
-                                 instead_of="nor could the hand hold its knob"))
+    elif _knob_lid(world, body):
+        yield from _close_lid(world, style, body, SWUNG_SHUT * span)
     elif _handled_door(world, body) and style.avoid_hazards:
         # pushed shut, holding nothing, where the arm follows the door's face; else by its
         # handle
@@ -255,11 +254,39 @@ def plan_close(world: World, style: Style, roles: dict[str, str]) -> Plan:
     elif _handled_door(world, body):
         yield from swing_door(world, style, body, SWUNG_SHUT * span)
     elif _hinged_panel(world, body):
-        knob = _knob_lid(world, body)
-        yield from push_shut(world, style, body, SWUNG_SHUT * span, instead_of=(
-            "its knob is wider than the gripper opens" if knob else ""))
+        yield from push_shut(world, style, body, SWUNG_SHUT * span)
     else:
         raise NotImplementedError(_unsupported(body, part.name, joint.type, "close"))
+
+
+def _close_lid(world: World, style: Style, body: str, angle: float) -> Plan:
+    """A lid with a knob: lowered by its knob's ends where the fingers open across them
+    (:func:`.hinge.lower_lid`), else pushed shut (:func:`.push_shut.push_shut`). Careful,
+    a lid standing past upright that no grip by the knob's ends brings down is first
+    pulled back over upright by its knob held flat (:func:`.lid_tab.pull_over`), and
+    lowered as above from where it rests, if it does not fall shut."""
+    fits = knob_pinch_fits(world, body)
+
+    past = style.avoid_hazards and hinge(world, body).now > np.pi / 2
+
+    def push() -> Plan:
+        held = "by its ends or flat" if past else ""
+        return push_shut(world, style, body, angle, instead_of=(
+            f"nor could the hand hold its knob {held}".rstrip() if fits
+            else "its knob is wider than the gripper opens"
+            + (", and no arm holds it flat" if past else "")))
+
+    def lower() -> Plan:
+        return lower_lid(world, style, body, angle, instead=push) if fits else push()
+
+    if not past:
+        yield from lower()
+        return
+
+    def pull() -> Plan:
+        return pull_over(world, style, body, angle, then=lower, instead=push)
+
+    yield from (lower_lid(world, style, body, angle, instead=pull) if fits else pull())
 
 
 def _sliding(world: World, body: str) -> bool:
