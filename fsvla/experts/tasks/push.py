@@ -23,6 +23,7 @@ from ..skills import (
 from ..style import Style
 from ..world import World
 from .common import retreat_home
+from .detour import detour
 from .lid import smooth_arc
 
 
@@ -33,19 +34,33 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
     far as the arm follows it and the next from where the object is then."""
     obj, target = roles["object"], roles["target"]
     arm = nearest_arm(world, world.body_pose(obj).p)
+    # careful: around the keep-outs, through the points of a detour first
+    via = detour(world, arm, obj, target) if style.avoid_hazards else []
+
+    def aim() -> NDArray[np.float64]:
+        """Where this leg pushes to: the next point of the detour not yet reached, else
+        the target."""
+        here = world.body_pose(obj).p
+        while via and float(np.linalg.norm((via[0] - here)[:2])) < VIA_REACHED:
+            via.pop(0)
+        return via[0] if via else world.body_pose(target).p
+
+    def arrived() -> bool:
+        return not via and _gap(world, obj, target) < PUSH_GAP
+
     # the first leg is laid out, and the one turn for the whole push chosen, on the line at
     # 40 % of the object's height, where things are before the fingers close
     bounds = world.bounds(obj)
-    start, goal = world.body_pose(obj).p, world.body_pose(target).p
+    start, goal = world.body_pose(obj).p, aim()
     line, direction, travel = _push_line(world, obj, start, goal, bounds)
     R = _push_frame(world, arm, line, direction, travel)
     yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
-    for leg in range(PUSH_LEGS):
+    for leg in range(PUSH_LEGS + len(via)):
         if leg:
             bounds = world.bounds(obj)
-            start, goal = world.body_pose(obj).p, world.body_pose(target).p
+            start, goal = world.body_pose(obj).p, aim()
             line, direction, travel = _push_line(world, obj, start, goal, bounds)
-            if travel < LEG_DONE or _gap(world, obj, target) < PUSH_GAP:
+            if travel < LEG_DONE or arrived():
                 break
             R = _push_frame(world, arm, line, direction, travel)
         behind = _off_the_table(world, arm, line, bounds)  # measured on the shut hand
@@ -57,7 +72,7 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
                 yield from _push_straight(world, style, arm, obj, Pose(behind, R),
                                           travel * direction)
                 moved = float(np.linalg.norm((world.body_pose(obj).p - start)[:2]))
-                if moved >= LEG_DONE and _gap(world, obj, target) >= PUSH_GAP:
+                if moved >= LEG_DONE and not arrived():
                     # a round object slides off the line of the hand's face: pushed again
                     # from where it went, as the legs below are
                     yield from _back_off(world, style, arm, direction)
@@ -86,7 +101,7 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
         yield Segment(settle=style.settle, label="push")
         moved = float(np.linalg.norm((world.body_pose(obj).p - start)[:2]))
         yield from _back_off(world, style, arm, direction)
-        if (whole and _gap(world, obj, target) < PUSH_GAP) or moved < LEG_DONE:
+        if (whole and arrived()) or moved < LEG_DONE:
             break
     yield from retreat_home(world, style, arm)
 
@@ -254,6 +269,10 @@ LEG_SHARES = (1.0, 0.75, 0.5, 0.3, 0.15)
 ROUTE_STEP = 0.03
 LEG_DONE = 0.01
 LEG_BACK = 0.02
+#: A point of a detour is passed once the object's centre is this close to it (m): a
+#: push ends with the object STANDOFF short of where it aims (the hand starts that far
+#: off it), and a shorter push than that moves nothing.
+VIA_REACHED = 0.03
 #: A push goes on, in another leg, while the object's box is farther than this (m) from
 #: the target's (the hand's face, not a gripper, steers a round object off its line).
 PUSH_GAP = 0.01
