@@ -52,7 +52,7 @@ def test_the_route_goes_round_the_heat_zone_clear_of_its_keep_out(tmp_path: Path
     env = make(str(_write(tmp_path, HEAT_ACROSS_THE_PUSH)), "L0", layout_seed(0, 0))
     env.reset()
     world = World.of_env(env)
-    via = detour(world, "arm", "block", "other_block")
+    via = detour(world, "arm", "block", "other_block").points
     assert via, "the straight line crosses the keep-out: a detour is needed"
     heat = next(o for o in world.obstacles() if o.name == "heat")
     route = [world.body_pose("block").p[:2], *(p[:2] for p in via),
@@ -71,7 +71,7 @@ def test_a_clear_line_needs_no_detour(tmp_path: Path) -> None:
     text = HEAT_ACROSS_THE_PUSH.replace("at (-10.2 cm, -3.9 cm)", "at (-30 cm, -3.9 cm)")
     env = make(str(_write(tmp_path, text)), "L0", layout_seed(0, 0))
     env.reset()
-    assert detour(World.of_env(env), "arm", "block", "other_block") == []
+    assert detour(World.of_env(env), "arm", "block", "other_block").points == []
     env.close()
 
 

@@ -13,6 +13,7 @@ keep-out the object or the target already lies in is left out (nothing avoids it
 from __future__ import annotations
 
 import heapq
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,10 +32,22 @@ CORNER_POINTS = 3
 HAND_HEIGHT = 0.12
 
 
-def detour(world: World, arm: str, obj: str, target: str) -> list[NDArray[np.float64]]:
+@dataclass
+class Detour:
     """The points (world, at the object's height) the object's centre is pushed through
-    before the target, in order: none where the straight line keeps clear (or no route
-    does)."""
+    before the target, in order, and the grown boxes they keep clear of (2-D)."""
+
+    points: list[NDArray[np.float64]]
+    boxes: list[tuple[NDArray[np.float64], NDArray[np.float64], float]]
+
+    def clear(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
+        """Whether the object's centre goes straight from ``a`` to ``b`` clear of them."""
+        return _clear(np.asarray(a[:2]), np.asarray(b[:2]), self.boxes)
+
+
+def detour(world: World, arm: str, obj: str, target: str) -> Detour:
+    """The route for ``obj``'s centre to ``target`` (module doc): no points where the
+    straight line keeps clear (or no route does)."""
     start, goal = world.body_pose(obj).p.copy(), world.body_pose(target).p.copy()
     lo, hi = world.bounds(obj)
     grow = max(0.5 * float(np.linalg.norm((hi - lo)[:2])), _hand_half_length(world, arm)) + SPARE
@@ -52,13 +65,13 @@ def detour(world: World, arm: str, obj: str, target: str) -> list[NDArray[np.flo
         boxes.append((o.lo[:2].copy(), o.hi[:2].copy(), keep))
     a, b = start[:2], goal[:2]
     if not boxes or _clear(a, b, boxes):
-        return []
+        return Detour([], boxes)
     nodes = [a, b] + [p for box in boxes for p in _around(*box)
                       if all(box_distance(p, lo2, hi2) >= keep2 for lo2, hi2, keep2 in boxes)]
     path = _shortest(nodes, boxes)
     if path is None:
-        return []
-    return [np.array([nodes[i][0], nodes[i][1], start[2]]) for i in path[1:-1]]
+        return Detour([], boxes)
+    return Detour([np.array([nodes[i][0], nodes[i][1], start[2]]) for i in path[1:-1]], boxes)
 
 
 def _hand_half_length(world: World, arm: str) -> float:
@@ -126,4 +139,4 @@ def _shortest(nodes: list[NDArray[np.float64]],
     return None
 
 
-__all__ = ["detour"]
+__all__ = ["Detour", "detour"]

@@ -35,30 +35,46 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
     obj, target = roles["object"], roles["target"]
     arm = nearest_arm(world, world.body_pose(obj).p)
     # careful: around the keep-outs, through the points of a detour first
-    via = detour(world, arm, obj, target) if style.avoid_hazards else []
+    way = detour(world, arm, obj, target) if style.avoid_hazards else None
+    via = way.points if way is not None else []
 
     def aim() -> NDArray[np.float64]:
-        """Where this leg pushes to: the next point of the detour not yet reached, else
-        the target."""
+        """Where this leg pushes to: the next point of the detour not yet passed (reached,
+        or the one after it in a clear line from where the object is), else the target."""
         here = world.body_pose(obj).p
-        while via and float(np.linalg.norm((via[0] - here)[:2])) < VIA_REACHED:
+        while via and (float(np.linalg.norm((via[0] - here)[:2])) < VIA_REACHED
+                       or way.clear(here, via[1] if len(via) > 1 else world.body_pose(target).p)):
             via.pop(0)
         return via[0] if via else world.body_pose(target).p
 
     def arrived() -> bool:
         return not via and _gap(world, obj, target) < PUSH_GAP
 
+    def aim_at(start: NDArray[np.float64], bounds) -> NDArray[np.float64]:
+        """Where this leg's line ends: a point of the detour pushed to so that the object
+        ends on it (the push ends STANDOFF short, and a round object's box across the
+        line is wider than the object), else the target."""
+        goal = aim()
+        if not via:
+            return goal
+        direction = horizontal(goal - start)
+        lo, hi = bounds
+        over = 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2]) - 0.5 * float(np.min((hi - lo)[:2]))
+        return goal + (STANDOFF + over) * direction
+
     # the first leg is laid out, and the one turn for the whole push chosen, on the line at
     # 40 % of the object's height, where things are before the fingers close
     bounds = world.bounds(obj)
-    start, goal = world.body_pose(obj).p, aim()
+    start = world.body_pose(obj).p
+    goal = aim_at(start, bounds)
     line, direction, travel = _push_line(world, obj, start, goal, bounds)
     R = _push_frame(world, arm, line, direction, travel)
     yield Segment(grippers={arm: 0.0}, gripper_steps=style.gripper_steps, label="close")
     for leg in range(PUSH_LEGS + len(via)):
         if leg:
             bounds = world.bounds(obj)
-            start, goal = world.body_pose(obj).p, aim()
+            start = world.body_pose(obj).p
+            goal = aim_at(start, bounds)
             line, direction, travel = _push_line(world, obj, start, goal, bounds)
             if travel < LEG_DONE or arrived():
                 break
@@ -269,9 +285,7 @@ LEG_SHARES = (1.0, 0.75, 0.5, 0.3, 0.15)
 ROUTE_STEP = 0.03
 LEG_DONE = 0.01
 LEG_BACK = 0.02
-#: A point of a detour is passed once the object's centre is this close to it (m): a
-#: push ends with the object STANDOFF short of where it aims (the hand starts that far
-#: off it), and a shorter push than that moves nothing.
+#: A point of a detour is passed once the object's centre is this close to it (m).
 VIA_REACHED = 0.03
 #: A push goes on, in another leg, while the object's box is farther than this (m) from
 #: the target's (the hand's face, not a gripper, steers a round object off its line).
