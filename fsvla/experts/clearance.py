@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from fsvla.compiler.monitor import RobotEntity, ZoneEntity
 from fsvla.compiler.pose import quat_to_matrix
 
-from .world import World
+from .world import World, nearest_box_distance
 
 #: Distance channels whose robot subjects the arm's links are checked against.
 METRICS = ("clearance", "zone_distance", "untouched", "do_not_disturb")
@@ -92,7 +92,7 @@ class ArmClearance:
         zone = self._zones.get(ref)
         if zone is None:  # a hazard body: its bounds now
             lo, hi = self.world.bounds(ref)
-            return _box_distance(p, lo, hi)
+            return nearest_box_distance(p, lo, hi)
         R0, p0 = quat_to_matrix(zone.pose.quaternion), np.asarray(zone.pose.position)
         region = zone.region
         R1, p1 = quat_to_matrix(region.pose.quaternion), np.asarray(region.pose.position)
@@ -104,14 +104,7 @@ class ArmClearance:
             inside = np.minimum(np.maximum(radial, axial), 0.0)
             return float(np.min(outside + inside))
         half = np.asarray(region.half_size, dtype=np.float64)
-        return _box_distance(local, -half, half)
-
-
-def _box_distance(p: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]) -> float:
-    gap = np.maximum(lo - p, p - hi)
-    outside = np.linalg.norm(np.maximum(gap, 0.0), axis=1)
-    inside = np.minimum(np.max(gap, axis=1), 0.0)
-    return float(np.min(outside + inside))
+        return nearest_box_distance(local, -half, half)
 
 
 __all__ = ["ArmClearance"]

@@ -42,6 +42,17 @@ def box_distance(p: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np
     return float(np.linalg.norm(np.maximum(0.0, np.maximum(lo - p, p - hi))))
 
 
+def nearest_box_distance(points: NDArray[np.float64], lo: NDArray[np.float64],
+                         hi: NDArray[np.float64]) -> float:
+    """The smallest signed distance (m) of any of ``points`` (one per row) to the
+    axis-aligned box ``lo``..``hi``: negative inside it; in as many dimensions as the
+    points have."""
+    gap = np.maximum(lo - points, points - hi)
+    outside = np.linalg.norm(np.maximum(gap, 0.0), axis=1)
+    inside = np.minimum(np.max(gap, axis=1), 0.0)
+    return float(np.min(outside + inside))
+
+
 @dataclass(frozen=True)
 class Obstacle:
     """An axis-aligned box the careful expert keeps ``margin`` away from."""
@@ -507,4 +518,4 @@ def _z_only(R: NDArray[np.float64]) -> NDArray[np.float64]:
     return rotation_between(np.array([0.0, 0.0, 1.0]), R[:, 2])
 
 
-__all__ = ["Obstacle", "World", "box_distance"]
+__all__ = ["Obstacle", "World", "box_distance", "nearest_box_distance"]

@@ -5,9 +5,11 @@ heat zone or a no-go column as a carry does. :func:`detour` finds the shortest r
 the object's centre from where it is to the target that keeps the object and the hand
 outside every keep-out (each hazard's box grown by its largest limit plus warning band,
 :meth:`World.obstacles`) with the object's half-width or the hand's half-length across
-the push, whichever is larger, to spare: straight where the line is clear, else through
-points on polygons drawn around the grown boxes (a visibility graph, shortest first). A
-keep-out the object or the target already lies in is left out (nothing avoids it).
+the push, whichever is larger, to spare (less where the object or the target stands
+nearer, as long as the object itself keeps clear): straight where the line is clear,
+else through points on polygons drawn around the grown boxes (a visibility graph,
+shortest first). A keep-out the object would not keep clear of where it or the target
+stands is left out (nothing avoids it).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..skills import DOWN
-from ..world import World, box_distance
+from ..world import World, box_distance, nearest_box_distance
 
 #: What (m) the route keeps beyond the keep-outs, for the hand's path off its command.
 SPARE = 0.01
@@ -50,8 +52,9 @@ def detour(world: World, arm: str, obj: str, target: str) -> Detour:
     straight line keeps clear (or no route does)."""
     start, goal = world.body_pose(obj).p.copy(), world.body_pose(target).p.copy()
     lo, hi = world.bounds(obj)
-    grow = max(0.5 * float(np.linalg.norm((hi - lo)[:2])), _hand_half_length(world, arm)) + SPARE
-    least = 0.5 * float(np.linalg.norm((hi - lo)[:2])) + SPARE
+    half = 0.5 * float(np.linalg.norm((hi - lo)[:2]))  # the object's, across any line
+    grow = max(half, _hand_half_length(world, arm)) + SPARE
+    least = half + SPARE
     boxes = []
     for o in world.obstacles(exclude=(obj, target)):
         if o.lo[2] > hi[2] + HAND_HEIGHT:
@@ -102,11 +105,7 @@ def _clear(a: NDArray[np.float64], b: NDArray[np.float64],
     """Whether the segment ``a``-``b`` keeps each box's ``keep`` (to CHECK_STEP)."""
     n = max(2, int(np.ceil(float(np.linalg.norm(b - a)) / CHECK_STEP)) + 1)
     points = a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)
-    for lo, hi, keep in boxes:
-        gap = np.maximum(0.0, np.maximum(lo - points, points - hi))
-        if float(np.min(np.linalg.norm(gap, axis=1))) < keep - 1e-3:
-            return False
-    return True
+    return all(nearest_box_distance(points, lo, hi) >= keep - 1e-3 for lo, hi, keep in boxes)
 
 
 def _shortest(nodes: list[NDArray[np.float64]],

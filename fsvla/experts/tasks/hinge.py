@@ -122,6 +122,39 @@ def _extent_along(shape, direction: NDArray[np.float64]) -> float:
 
 
 @dataclass(frozen=True)
+class Knob:
+    """A lid's knob, in the lid's link frame: its box shape and centre, and the lid's
+    axes: along the hinge, the lid's thin axis (up when shut), and out from the hinge
+    toward the knob (which stands proud of the lid's far edge)."""
+
+    shape: object
+    centre: NDArray[np.float64]
+    along: NDArray[np.float64]
+    normal: NDArray[np.float64]
+    outward: NDArray[np.float64]
+
+    def extent(self, direction: NDArray[np.float64]) -> float:
+        """The knob's full extent (m) along ``direction`` (the lid's frame)."""
+        return _extent_along(self.shape, direction)
+
+
+def knob_of(world: World, body: str, h: Hinge) -> Knob:
+    """``body``'s lid knob and the lid's axes (:class:`Knob`), its hinge ``h``."""
+    part, _joint = world.part(body)
+    knob = world.shape(body, "knob", link=part.link)
+    panel = world.shape(body, "panel", link=part.link)
+    along = h.closed.T @ h.axis
+    normal_axis = int(np.argmin(np.abs(np.asarray(panel.half_size))))
+    normal = np.eye(3)[normal_axis]
+    if h.closed[:, normal_axis] @ UP < 0:
+        normal = -normal
+    c = np.asarray(knob.pose.position, dtype=np.float64)
+    outward = c - normal * (c @ normal) - along * (c @ along)
+    outward /= max(np.linalg.norm(outward), 1e-9)
+    return Knob(knob, c, along, normal, outward)
+
+
+@dataclass(frozen=True)
 class LidGrip:
     """How a hand holds a lid's knob along its arc: the arm, the knob's width between the
     fingers, the TCP pose beyond the knob it comes in from, the TCP pose at each lid angle,
@@ -140,23 +173,12 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
     Careful: the first fixed turn on the lid whose whole arc one IK branch follows; with
     ``turning``, instead a turn that changes along the arc (:func:`_turning_grip`); None
     if none is found. Careless: the first fixed turn."""
-    part, _joint = world.part(body)
-    knob = world.shape(body, "knob", link=part.link)
     h = hinge(world, body)
     now = start
-    c = np.asarray(knob.pose.position, dtype=np.float64)
-    half = np.abs(np.asarray(knob.half_size, dtype=np.float64))
-    along = h.closed.T @ h.axis  # the hinge axis in the lid's frame
-    width = _extent_along(knob, along)
-    panel = world.shape(body, "panel", link=part.link)
-    normal_axis = int(np.argmin(np.abs(np.asarray(panel.half_size))))
-    normal = np.eye(3)[normal_axis]  # the lid's thin axis (up when shut)
-    if h.closed[:, normal_axis] @ UP < 0:
-        normal = -normal
-    # the knob stands proud of the lid's far edge, away from the hinge
-    outward = c - normal * (c @ normal) - along * (c @ along)
-    outward /= max(np.linalg.norm(outward), 1e-9)
-    root = c - outward * float(np.abs(half) @ np.abs(outward))  # the lid's edge
+    knob = knob_of(world, body, h)
+    c, normal, outward = knob.centre, knob.normal, knob.outward
+    width = knob.extent(knob.along)
+    root = c - outward * 0.5 * knob.extent(outward)  # the lid's edge
     arm = nearest_arm(world, h.at(c, now))
     tip, thick = finger_box(world, arm)
     centre = world.grip_centre(arm, width + FIXED_JAW_CLEARANCE)
@@ -613,6 +635,6 @@ def sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose]
         yield Segment({arm: pose_at(float(theta))}, speed=style.approach_speed, label=label)
 
 
-__all__ = ["FELT", "Hinge", "LidGrip", "finger_box", "hinge", "knob_pinch", "knob_pinch_fits", "let_go",
-           "lid_pose", "lower_lid", "pinch", "pinch_force", "squeeze_on", "sweep", "swing_door",
+__all__ = ["FELT", "Hinge", "Knob", "LidGrip", "finger_box", "hinge", "knob_of", "knob_pinch",
+           "knob_pinch_fits", "let_go", "lid_pose", "lower_lid", "pinch", "pinch_force", "squeeze_on", "sweep", "swing_door",
            "swing_lid"]

@@ -26,7 +26,18 @@ from ..motion import Pose, Segment
 from ..skills import FIXED_JAW_CLEARANCE, Plan, attained, branch_for_path, nearest_arm, transit
 from ..style import Style
 from ..world import World
-from .hinge import FELT, LidGrip, hinge, knob_pinch, let_go, lid_pose, pinch, sweep
+from .hinge import (
+    ARC_POSES,
+    FELT,
+    LidGrip,
+    hinge,
+    knob_of,
+    knob_pinch,
+    let_go,
+    lid_pose,
+    pinch,
+    sweep,
+)
 
 #: How far (m) in from the tab's tip the TCP holds it.
 TAB_DEPTH = 0.008
@@ -37,8 +48,6 @@ TAB_TURNS = (0.0, 30.0, -30.0, 60.0, -60.0)
 PULL_ENDS = (60.0, 70.0, 80.0)
 #: How far (m) beyond the tab's tip, along the lid, the hand comes down from.
 BEYOND = 0.06
-#: How many poses along the arc are checked for one IK branch that follows them.
-ARC_POSES = 12
 
 
 def tab_grip(world: World, style: Style, body: str, end: float) -> LidGrip | None:
@@ -46,23 +55,14 @@ def tab_grip(world: World, style: Style, body: str, end: float) -> LidGrip | Non
     the first turn of the hand (TAB_TURNS, either way round) whose whole arc, from
     BEYOND the tip on, one IK branch follows; None where none is, or where the tab is
     thinner than the fingers shut or wider than they open."""
-    part, _joint = world.part(body)
-    knob = world.shape(body, "knob", link=part.link)
-    panel = world.shape(body, "panel", link=part.link)
     h = hinge(world, body)
-    along = h.closed.T @ h.axis  # the hinge axis in the lid's frame
-    normal = np.eye(3)[int(np.argmin(np.abs(np.asarray(panel.half_size))))]
-    if h.closed @ normal @ np.array([0.0, 0.0, 1.0]) < 0:
-        normal = -normal  # the lid's thin axis, up when shut
-    c = np.asarray(knob.pose.position, dtype=np.float64)
-    outward = c - normal * (c @ normal) - along * (c @ along)
-    outward /= max(float(np.linalg.norm(outward)), 1e-9)
-    half = np.abs(np.asarray(knob.half_size, dtype=np.float64))
-    thickness = 2.0 * float(half @ np.abs(normal))
-    arm = nearest_arm(world, h.at(c, h.now))
+    knob = knob_of(world, body, h)
+    along, normal, outward = knob.along, knob.normal, knob.outward
+    thickness = knob.extent(normal)
+    arm = nearest_arm(world, h.at(knob.centre, h.now))
     if world.min_width(arm) > thickness or not fits(world, arm, thickness):
         return None
-    held = c + outward * (float(half @ np.abs(outward)) - TAB_DEPTH)
+    held = knob.centre + outward * (0.5 * knob.extent(outward) - TAB_DEPTH)
     centre = world.grip_centre(arm, thickness + FIXED_JAW_CLEARANCE)
 
     def frame(turn: float, flip: bool) -> NDArray[np.float64]:

@@ -266,15 +266,16 @@ def _close_lid(world: World, style: Style, body: str, angle: float) -> Plan:
     pulled back over upright by its knob held flat (:func:`.lid_tab.pull_over`), and
     lowered as above from where it rests, if it does not fall shut."""
     fits = knob_pinch_fits(world, body)
-
     past = style.avoid_hazards and hinge(world, body).now > np.pi / 2
 
+    if fits:
+        tried = "nor could the hand hold its knob" + (" by its ends or flat" if past else "")
+    else:
+        tried = "its knob is wider than the gripper opens" + (", and no arm holds it flat"
+                                                               if past else "")
+
     def push() -> Plan:
-        held = "by its ends or flat" if past else ""
-        return push_shut(world, style, body, angle, instead_of=(
-            f"nor could the hand hold its knob {held}".rstrip() if fits
-            else "its knob is wider than the gripper opens"
-            + (", and no arm holds it flat" if past else "")))
+        return push_shut(world, style, body, angle, instead_of=tried)
 
     def lower() -> Plan:
         return lower_lid(world, style, body, angle, instead=push) if fits else push()

@@ -59,7 +59,7 @@ def plan_push(world: World, style: Style, roles: dict[str, str]) -> Plan:
             return goal
         direction = horizontal(goal - start)
         lo, hi = bounds
-        over = 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2]) - 0.5 * float(np.min((hi - lo)[:2]))
+        over = _half_along(direction, bounds) - 0.5 * float(np.min((hi - lo)[:2]))
         return goal + (STANDOFF + over) * direction
 
     # the first leg is laid out, and the one turn for the whole push chosen, on the line at
@@ -164,10 +164,18 @@ def _push_line(world: World, obj: str, start: NDArray[np.float64],
     push direction and its length."""
     direction = horizontal(goal - start)
     lo, hi = bounds
-    reach = 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2]) + STANDOFF
+    reach = _half_along(direction, bounds) + STANDOFF
     height = lo[2] + 0.4 * (hi[2] - lo[2])
     behind = np.array([start[0], start[1], height]) - reach * direction
     return behind, direction, float(np.linalg.norm((goal - start)[:2]))
+
+
+def _half_along(direction: NDArray[np.float64],
+                bounds: tuple[NDArray[np.float64], NDArray[np.float64]]) -> float:
+    """Half the extent (m) of the object's box ``bounds`` along ``direction`` over the
+    table."""
+    lo, hi = bounds
+    return 0.5 * float(np.abs(direction[:2]) @ (hi - lo)[:2])
 
 
 def _off_the_table(world: World, arm: str, point: NDArray[np.float64],
