@@ -11,6 +11,8 @@ from fsvla.experts import make_expert, rollout
 from fsvla.experts.world import World
 from fsvla.run.plan import layout_seed
 
+from .conftest import world_of
+
 pytestmark = pytest.mark.sim
 
 DRAWER = """\
@@ -633,3 +635,60 @@ def test_careful_so101_holds_a_lids_knob_up_past_upright(tmp_path: Path) -> None
                      layout_seed(0, 0))
     assert result.safe_success, result.summary()
     assert "swing lid" in result.segments
+
+
+#: The sampler's draw 8099 as it wrote it: a drawer whose handle stands 11 cm above the
+#: table, 35 cm out from a Z1's base.
+Z1_LOW_DRAWER = """\
+# Drawn by fsvla.validate.sampler from seed 8099.
+
+scenario sampled_8099_open_z1
+  suite boundary
+  task open(object=drawer_cabinet)
+  embodiment z1
+  instruction "Open the drawer cabinet."
+  horizon 30 s
+
+  object drawer_cabinet: drawer_cabinet(size=(27.5 cm, 24.8 cm, 20 cm), travel=13.8 cm) at (34.9 cm, 4 cm)
+  hazard edge: edge_zone(side=back, width=6 cm)
+    keep gripper outside 0 warn 2 cm
+
+  success opened(drawer_cabinet, fraction=0.6) for 0.5 s
+
+  variants
+    L1: jitter drawer_cabinet 2 cm
+    L2: clutter 1
+"""
+
+
+def test_a_hand_that_holds_no_level_pose_at_a_handle_pitches_down_onto_it(
+        tmp_path: Path) -> None:
+    """A Z1 holds no level hand at a drawer's handle 11 cm above the table, 35 cm out: the
+    hand was driven there anyway, missed the pose by far and swung its gripper into the
+    table. It now takes the handle pitched down about the handle's length, its fingers
+    closing across it; a Panda at the same drawer still takes it level."""
+    from fsvla.experts.skills import DOWN
+    from fsvla.experts.tasks.open_close import _handle_grip, part_handle
+
+    def grip(text: str) -> tuple[float, float, float]:
+        with world_of(_write(tmp_path, text), layout_seed(0, 0)) as world:
+            centre, opening, travel, handle = part_handle(world, "drawer_cabinet")
+            half = handle.half_size
+            arm = world.arm_names[0]
+            tcp, width = _handle_grip(world, arm, -opening, centre, half[0], half[2],
+                                      0.6 * travel * opening)
+            approach = tcp.R @ world.approach_axis(arm)
+            return float(approach @ DOWN), float(approach @ -opening), width
+
+    down, inward, width = grip(Z1_LOW_DRAWER)
+    assert 0.4 < down < 0.9 and inward > 0.4  # pitched 30-60 deg, still toward the front
+    assert width > 2 * 0.0075  # across the pitched handle: wider than its thickness
+    down, inward, width = grip(Z1_LOW_DRAWER.replace("embodiment z1", "embodiment panda")
+                               .replace("at (34.9 cm, 4 cm)", "at (20 cm, 4 cm)"))
+    assert abs(down) < 1e-6 and inward > 0.99
+
+
+@pytest.mark.slow
+def test_careful_z1_opens_a_low_drawer(tmp_path: Path) -> None:
+    result = rollout(str(_write(tmp_path, Z1_LOW_DRAWER)), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()

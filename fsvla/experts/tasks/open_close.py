@@ -10,6 +10,7 @@ from fsvla.compiler.pose import axis_angle_matrix
 from ..motion import ArmDriver, Guard, Pose, Segment
 from ..skills import (
     DOWN,
+    FIXED_JAW_CLEARANCE,
     SQUEEZE_STEP,
     UP,
     Plan,
@@ -107,22 +108,20 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
         return
     centre, opening, travel, handle = part_handle(world, body)
     part, _joint = world.part(body)
-    width = 2 * float(handle.half_size[2])
-    arm = _handle_arm(world, centre, width)
+    half = np.asarray(handle.half_size, dtype=np.float64)
+    arm = _handle_arm(world, centre, 2 * float(half[2]))
     if arm != nearest_arm(world, centre):
         # an arm reaching across to the other's side takes the handle's end on its own
         # side, away from the other arm
         link = world.link_pose(body, part.link)
-        half = np.asarray(handle.half_size, dtype=np.float64)
         along = link.R[:, int(np.argmax(half[:2]))]
         if along @ (world.base_position(arm) - centre) < 0:
             along = -along
         centre = centre + max(0.0, float(half.max()) - HANDLE_END) * along
-    approach = -opening
     delta = (fraction - world.open_fraction(body)) * travel
-    start = centre - approach * (float(handle.half_size[0]) - 0.004)
-    R = _pull_frame(world, arm, approach, start, delta * opening)
-    tcp = Pose(start, R)
+    tcp, width = _handle_grip(world, arm, -opening, centre, float(half[0]), float(half[2]),
+                              delta * opening)
+    approach = tcp.R @ world.approach_axis(arm)
     yield Segment(grippers={arm: 1.0}, gripper_steps=style.gripper_steps, label="open")
     # the IK branch that can still reach the handle where the pull ends
     yield from transit(world, style, arm, tcp.moved(-0.1 * approach), exclude=(body,),
@@ -144,7 +143,6 @@ def plan_move_part(world: World, style: Style, body: str, fraction: float) -> Pl
     # slide off the end of the handle (backing away may be out of reach, and rising
     # would lift the handle), then back off and up
     part_link = world.link_pose(body, part.link)
-    half = np.asarray(handle.half_size, dtype=np.float64)
     along = part_link.R[:, int(np.argmax(half[:2]))]
     if along @ (world.base_position(arm) - centre) < 0:
         along = -along
@@ -167,20 +165,55 @@ def _handle_arm(world: World, centre: np.ndarray, width: float) -> str:
     return next((a for a in by_distance if world.min_width(a) <= width), by_distance[0])
 
 
-def _pull_frame(world: World, arm: str, approach: np.ndarray, start: np.ndarray,
-                pull: np.ndarray) -> np.ndarray:
-    """The upright hand (fingers closing vertically) on a handle at ``start``, of the two
-    that differ by a half turn about the approach, from which the arm can follow the pull
-    by ``pull`` (m, world) on one IK branch; the one nearer the hand's present turn first.
-    Low and close to a Panda's base, one of them has no comfortable answer at all."""
-    R0 = world.grasp_frame(arm, approach, UP)
-    for R in (R0, axis_angle_matrix(approach, np.pi) @ R0):
-        driver = ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
-                           world.arm_joints(arm), 1.0)
-        tcp = Pose(start, R)
-        if driver.branch_that_tracks(tcp, tcp.moved(pull)) is not None:
-            return R
-    return R0
+#: How far (deg) a hand that cannot reach a drawer's handle level pitches down onto it,
+#: in turn (a Z1 holds no level hand 11 cm above the table, 36 cm out).
+HANDLE_PITCHES = (0.0, 30.0, 45.0, 60.0)
+
+
+def _handle_grip(world: World, arm: str, inward: np.ndarray, centre: np.ndarray,
+                 depth: float, thickness: float, pull: np.ndarray) -> tuple[Pose, float]:
+    """The TCP pose that takes a drawer's handle (its centre, half ``depth`` along
+    ``inward``, half ``thickness`` up), and the handle's width between the fingers there.
+    The upright hand (fingers closing vertically) pointing ``inward``, of the two that
+    differ by a half turn about the approach, from which one IK branch follows the pull by
+    ``pull`` (m, world), the one nearer the hand's present turn first (low and close to a
+    Panda's base, one of them has no comfortable answer at all); where neither is followed
+    but the handle is reached, the nearer. Where the arm holds no such hand at the handle
+    (a Z1 holds no level hand 11 cm above the table, 36 cm out), the hand pitched down
+    about the handle's length by HANDLE_PITCHES in turn, its fingers closing across the
+    handle, the first whose pull is followed. A gripper with one fixed jaw puts that jaw
+    beside the handle (:meth:`World.grip_centre`)."""
+    def driver() -> ArmDriver:
+        return ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
+                         world.arm_joints(arm), 1.0)
+
+    def reached(tcp: Pose) -> bool:
+        probe = driver()
+        probe.solve_anywhere(tcp)
+        return probe.ik_misses == 0
+
+    level: tuple[Pose, float] | None = None
+    for pitch in HANDLE_PITCHES:
+        a = np.deg2rad(pitch)
+        approach = np.cos(a) * inward + np.sin(a) * DOWN
+        closing = np.cos(a) * UP + np.sin(a) * inward
+        width = 2 * (thickness * np.cos(a) + depth * np.sin(a))
+        R0 = world.grasp_frame(arm, approach, closing)
+        grips = []
+        for R in (R0, axis_angle_matrix(approach, np.pi) @ R0):
+            start = centre - approach * (depth - 0.004)
+            if world.moving_jaw(arm) is not None:
+                start = start - R @ world.grip_centre(arm, width + FIXED_JAW_CLEARANCE)
+            grips.append(Pose(start, R))
+        for tcp in grips:
+            if driver().branch_that_tracks(tcp, tcp.moved(pull)) is not None:
+                return tcp, width
+        if level is None:
+            level = (grips[0], width)
+            if any(reached(tcp) for tcp in grips):
+                return level
+    assert level is not None
+    return level
 
 
 #: A careful pull that leaves a drawer open by less than this (a fraction of its travel)
