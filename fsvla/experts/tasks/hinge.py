@@ -376,7 +376,7 @@ def swing_lid(world: World, style: Style, body: str, angle: float,
     yield Segment(grippers={arm: opening}, gripper_steps=style.gripper_steps, label="open")
     yield from transit(world, style, arm, back, exclude=(body,), then=start, follow=arc)
     yield Segment({arm: start}, speed=0.5 * style.approach_speed, label="to knob")
-    yield from pinch(world, style, arm, body, width, *knob_pinch(world, style, arm))
+    yield from pinch(world, style, arm, body, width, *knob_pinch(world, style, arm, body))
     if style.avoid_hazards and world.hand_force(arm, body, fingers=True) < FELT:
         if missed is not None:
             yield from let_go(world, style, arm, opening, 0.05)
@@ -555,16 +555,25 @@ def swing_door(world: World, style: Style, body: str, angle: float) -> Plan:
 #: N or more) brings the fixed jaw onto the knob with a jump of 60-110 N.
 KNOB_SQUEEZE = 12.0
 KNOB_FELT = 0.5
+#: Where no `contact_force` limit watches the hand or the lid, the squeeze (N) a careful
+#: pinch of a knob by a jaw on a hinge closes on until it feels all of: the fixed jaw
+#: comes onto the knob too (the swinging jaw alone at 12 N let an SO-101's knob slip out
+#: as the lid came up, 6-10 deg open, on most of its lids).
+KNOB_FIRM = 30.0
 #: The share of its squeeze at which a careful pinch otherwise closes no further.
 PINCH_FELT = 0.8
 
 
-def knob_pinch(world: World, style: Style, arm: str) -> tuple[float | None, float]:
+def knob_pinch(world: World, style: Style, arm: str,
+               body: str | None = None) -> tuple[float | None, float]:
     """The squeeze (N) a careful pinch of a knob by ``arm`` wants and the share of it felt
-    at which it closes no further: KNOB_SQUEEZE and KNOB_FELT for a jaw on a hinge, else
-    the style's grip force (None) and PINCH_FELT."""
+    at which it closes no further: for a jaw on a hinge, KNOB_FIRM all felt where no
+    contact-force limit watches the hand or ``body`` (when given), else KNOB_SQUEEZE and
+    KNOB_FELT; for other grippers the style's grip force (None) and PINCH_FELT."""
     if style.grip_force is None or world.moving_jaw(arm) is None:
         return None, PINCH_FELT
+    if body is not None and world.force_allowance(body, *world.gripper_entities) is None:
+        return max(style.grip_force, KNOB_FIRM), 1.0
     return max(style.grip_force, KNOB_SQUEEZE), KNOB_FELT
 
 
