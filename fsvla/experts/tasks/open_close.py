@@ -10,10 +10,11 @@ from fsvla.compiler.pose import axis_angle_matrix
 from ..motion import ArmDriver, Guard, Pose, Segment
 from ..skills import (
     DOWN,
-    FIXED_JAW_CLEARANCE,
     SQUEEZE_STEP,
     UP,
+    Grasp,
     Plan,
+    fixed_jaw_shifted,
     free_speed,
     nearest_arm,
     opening_for,
@@ -198,17 +199,14 @@ def _handle_grip(world: World, arm: str, inward: np.ndarray, centre: np.ndarray,
         approach = np.cos(a) * inward + np.sin(a) * DOWN
         closing = np.cos(a) * UP + np.sin(a) * inward
         width = 2 * (thickness * np.cos(a) + depth * np.sin(a))
+        start = centre - approach * (depth - 0.004)
         R0 = world.grasp_frame(arm, approach, closing)
-        grips = []
-        for R in (R0, axis_angle_matrix(approach, np.pi) @ R0):
-            start = centre - approach * (depth - 0.004)
-            if world.moving_jaw(arm) is not None:
-                start = start - R @ world.grip_centre(arm, width + FIXED_JAW_CLEARANCE)
-            grips.append(Pose(start, R))
+        grips = [fixed_jaw_shifted(world, arm, Grasp(Pose(start, R), width, approach)).pose
+                 for R in (R0, axis_angle_matrix(approach, np.pi) @ R0)]
         for tcp in grips:
             if driver().branch_that_tracks(tcp, tcp.moved(pull)) is not None:
                 return tcp, width
-        if level is None:
+        if level is None:  # the level hand: taken where reached, its pull followed or not
             level = (grips[0], width)
             if any(reached(tcp) for tcp in grips):
                 return level
