@@ -9,9 +9,10 @@ keep-out distances only in the careful style) before it moves sideways.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from itertools import pairwise
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,7 +21,9 @@ from fsvla.compiler.pose import axis_angle_matrix, rotation_angle, slerp
 
 from .motion import ArmDriver, Guard, Pose, Segment
 from .style import Style
-from .world import World
+from .world import World, box_distance
+
+T = TypeVar("T")
 
 DOWN = np.array([0.0, 0.0, -1.0])
 UP = np.array([0.0, 0.0, 1.0])
@@ -69,6 +72,9 @@ PRECLOSE_GAP_HINGED = 0.015
 CREEP_GAP = 0.004
 CREEP_STEP = 0.0005
 CREEP_STEPS = 400
+#: How far (m) outside every keep-out a careful hand on a part (a lid's knob, a panel's
+#: face) stays, where a grip or push that does so is followed (:func:`hand_clearance`).
+HAZARD_SPARE = 0.03
 #: How close (m) the tips of a jaw on a hinge may come to what a grasped object stands on.
 TIP_GAP = 0.004
 #: How far (m) beyond a pose, away from the arm's base, the arm must still reach for the
@@ -780,6 +786,37 @@ def hand_body(world: World, arm: str, pose: Pose) -> tuple[NDArray[np.float64], 
     return body, body + across, body - across
 
 
+def hand_clearance(world: World, arm: str, poses: tuple[Pose, ...],
+                   exclude: tuple[str, ...] = ()) -> float:
+    """How far (m) outside every obstacle's keep-out (:meth:`World.obstacles`, less
+    ``exclude``) the hand stays at ``poses``: its TCP and :func:`hand_body` (inf without
+    obstacles)."""
+    obstacles = world.obstacles(exclude=exclude)
+    least = np.inf
+    for pose in poses:
+        for point in (pose.p, *hand_body(world, arm, pose)):
+            for o in obstacles:
+                least = min(least, box_distance(point, o.lo, o.hi) - o.margin)
+    return float(least)
+
+
+def first_clear(options: Iterable[T], followed: Callable[[T], bool],
+                clearance: Callable[[T], float]) -> T | None:
+    """The first of ``options`` that is ``followed`` (one IK branch, say) and keeps
+    HAZARD_SPARE of ``clearance``; where none does, the followed one that keeps the
+    most; None where none is followed."""
+    best: tuple[float, T] | None = None
+    for option in options:
+        if not followed(option):
+            continue
+        clear = clearance(option)
+        if clear >= HAZARD_SPARE:
+            return option
+        if best is None or clear > best[0]:
+            best = (clear, option)
+    return None if best is None else best[1]
+
+
 def top_down_grasp(world: World, arm: str, centre: NDArray[np.float64],
                    closing: NDArray[np.float64], width: float) -> Grasp:
     R = world.grasp_frame(arm, DOWN, closing)
@@ -828,6 +865,7 @@ def horizontal(v: NDArray[np.float64]) -> NDArray[np.float64]:
 
 __all__ = [
     "DOWN",
+    "HAZARD_SPARE",
     "UP",
     "Grasp",
     "Plan",
@@ -837,6 +875,7 @@ __all__ = [
     "carrying_style",
     "clear_height",
     "close_on",
+    "first_clear",
     "force_watched",
     "free_speed",
     "gentle",
@@ -846,6 +885,7 @@ __all__ = [
     "grip_force_cap",
     "grip_guard",
     "hand_body",
+    "hand_clearance",
     "held_offset",
     "holdable_lever",
     "horizontal",

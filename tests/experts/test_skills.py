@@ -121,3 +121,19 @@ def test_a_five_joint_arm_turns_what_it_carries_as_it_turns_about_its_base() -> 
         now = world.current_pose("right")
         assert np.array_equal(carried_rotation(world, "right", now.p + np.array([0.0, 0.3, 0.0])),
                               now.R)
+
+
+def test_first_clear_takes_the_first_followed_option_that_keeps_the_spare() -> None:
+    """A careful grip or push takes the first option the arm follows whose hand keeps
+    HAZARD_SPARE outside every keep-out; where none does, the followed one that keeps the
+    most; where none is followed, none."""
+    from fsvla.experts.skills import HAZARD_SPARE, first_clear
+
+    clearance = {"a": 0.5, "b": HAZARD_SPARE - 0.01, "c": HAZARD_SPARE + 0.001,
+                 "d": HAZARD_SPARE + 0.02}
+    followed = {"a": False, "b": True, "c": True, "d": True}
+    assert first_clear("abcd", followed.__getitem__, clearance.__getitem__) == "c"
+    assert first_clear("ab", followed.__getitem__, clearance.__getitem__) == "b"
+    less = {"b": -0.02, "c": 0.01, "d": -0.01}
+    assert first_clear("bcd", followed.__getitem__, less.__getitem__) == "c"
+    assert first_clear("a", followed.__getitem__, clearance.__getitem__) is None

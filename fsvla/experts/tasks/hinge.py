@@ -36,8 +36,10 @@ from ..skills import (
     Plan,
     attained,
     branch_for_path,
+    first_clear,
     free_speed,
     grip_guard,
+    hand_clearance,
     nearest_arm,
     opening_for,
     reaches,
@@ -247,7 +249,13 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
     options = [fixed(turn(p, f), root + outward * inner(p)) for p in psis for f in (False, True)]
     pose_at: Callable[[float], Pose] | None = options[0]
     if style.avoid_hazards:
-        pose_at = None if turning else next((o for o in options if follows(o)), None)
+        def clearance(option: Callable[[float], Pose]) -> float:
+            back, arc = followed[option]
+            return hand_clearance(world, arm, (back, *arc), (body,))
+
+        # the first fixed turn that keeps the hand clear of the keep-outs (a hand pointing
+        # at the knob across the box reaches back toward what stands behind it)
+        pose_at = None if turning else first_clear(options, follows, clearance)
         if turning:
             pose_at = _turning_grip(world, arm, now, angle, turn, inner, upright, follows,
                                     lambda R, out, t: held(t, R, root + outward * out))

@@ -24,13 +24,14 @@ from ..skills import (
     Plan,
     attained,
     branch_for_path,
+    first_clear,
     free_speed,
-    hand_body,
+    hand_clearance,
     nearest_arm,
     transit,
 )
 from ..style import Style
-from ..world import World, box_distance
+from ..world import World
 from .common import push_force
 from .hinge import Hinge, hinge
 from .lid import smooth_arc
@@ -47,8 +48,6 @@ STANDOFF = 0.05
 ARC_POSES = 12
 #: How far (m) the hand backs off the shut panel before it rises.
 BACK_OFF = 0.03
-#: How far (m) outside every keep-out the careful push keeps the hand, where a push does.
-HAZARD_SPARE = 0.03
 
 
 @dataclass(frozen=True)
@@ -197,35 +196,20 @@ def _first_followed(world: World, arm: str, body: str, h: Hinge, face: Face,
     """The first push (its leans, least change first, and the hand's turn) whose arc one
     IK branch follows with the hand HAZARD_SPARE outside every keep-out, from STANDOFF
     off the face to where it backs off after; where none keeps that, the followed one
-    that stays farthest out; None where none is followed."""
-    best: tuple[float, Callable[[float], Pose]] | None = None
-    for lean_a, lean_b in leans:
-        for flip in (False, True):
-            pose_at = _pushing(world, arm, h, face, lean_a, lean_b, flip)
-            arc = tuple(pose_at(float(t)) for t in np.linspace(h.now, angle, ARC_POSES))
-            off = STANDOFF * _normal_at(h, face, h.now)
-            if branch_for_path(world, arm, (arc[0].moved(off), *arc)) is None:
-                continue
-            away = arc[-1].moved(BACK_OFF * _normal_at(h, face, angle))
-            clear = _clearance(world, arm, body, (arc[0].moved(off), *arc, away))
-            if clear >= HAZARD_SPARE:
-                return pose_at
-            if best is None or clear > best[0]:
-                best = (clear, pose_at)
-    return None if best is None else best[1]
+    that stays farthest out (:func:`first_clear`); None where none is followed."""
+    off = STANDOFF * _normal_at(h, face, h.now)
+    away = BACK_OFF * _normal_at(h, face, angle)
 
+    def path(pose_at: Callable[[float], Pose]) -> tuple[Pose, ...]:
+        arc = tuple(pose_at(float(t)) for t in np.linspace(h.now, angle, ARC_POSES))
+        return (arc[0].moved(off), *arc, arc[-1].moved(away))
 
-def _clearance(world: World, arm: str, body: str, poses: tuple[Pose, ...]) -> float:
-    """How far (m) outside every obstacle's keep-out the hand stays at ``poses``: its TCP,
-    its body 6 cm back along the approach and that body's two ends along the finger axis
-    (inf without obstacles)."""
-    obstacles = world.obstacles(exclude=(body,))
-    least = np.inf
-    for pose in poses:
-        for point in (pose.p, *hand_body(world, arm, pose)):
-            for o in obstacles:
-                least = min(least, box_distance(point, o.lo, o.hi) - o.margin)
-    return float(least)
+    def followed(pose_at: Callable[[float], Pose]) -> bool:
+        return branch_for_path(world, arm, path(pose_at)[:-1]) is not None
+
+    options = (_pushing(world, arm, h, face, lean_a, lean_b, flip)
+               for lean_a, lean_b in leans for flip in (False, True))
+    return first_clear(options, followed, lambda o: hand_clearance(world, arm, path(o), (body,)))
 
 
 __all__ = ["Face", "push_shut", "pushed_face"]
