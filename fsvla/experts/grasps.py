@@ -221,9 +221,32 @@ def _mug(world: World, arm: str, obj: str) -> list[Grasp]:
     outer = float(grip.pose.position[0] + side * grip.half_size[0])
     if not fits(world, arm, abs(outer - inner)):  # a kettle's, in Baxter's hand
         return _cylinder(world, arm, obj)
+    if world.finger_box(arm)[1] + INSIDE_SPARE > _chord(world, obj, inner):
+        # a finger too wide to go into the cup beside the handle (a Z1's 8 cm jaw lands on
+        # a 6 cm cup's rim): around the body, where the gripper opens that wide
+        around = _cylinder(world, arm, obj)
+        if around:
+            return around
     z = float(high.pose.position[2])
     centre = world.to_world(obj, (0.5 * (inner + outer), 0.0, z))
     return [top_down_grasp(world, arm, centre, pose.R[:, 0], abs(outer - inner))]
+
+
+#: How much room (m) a finger inside a cup keeps from its wall on either side.
+INSIDE_SPARE = 0.004
+
+
+def _chord(world: World, obj: str, x: float) -> float:
+    """Half the width (m) of the inside of the cup ``obj`` across its local x axis at
+    ``x``: what a finger that goes in there may be wide on either side of the axis. The
+    inside's radius is the walls' inner face (the `radius` less 5 mm without walls)."""
+    walls = [shape for shape in world.asset(obj).collision if shape.name.startswith("wall")]
+    if walls:
+        inside = min(float(np.hypot(*np.asarray(w.pose.position)[:2])) - float(w.half_size[0])
+                     for w in walls)
+    else:
+        inside = world.param(obj, "radius") - 0.005
+    return float(np.sqrt(max(0.0, inside * inside - x * x)))
 
 
 def _handle_side(world: World, obj: str) -> float:

@@ -32,6 +32,8 @@ PALM_CLEARANCE = 0.009
 HAND_DEPTH = 0.028
 #: How far (m) behind the TCP, along the approach, a finger's hull counts as its pad.
 PAD_DEPTH = 0.035
+#: How far back from the TCP (m) the fingers' hulls are measured for their thickness.
+NEAR_TIP = 0.02
 #: How much wider (m) than the gap its shut fingers leave an object must be to be squeezed.
 SQUEEZE_SPARE = 0.004
 
@@ -445,6 +447,25 @@ class World:
             return None
         pose = self.state.robot_link_pose(arm, link)
         return vertices @ quat_to_matrix(pose.q).T + np.asarray(pose.p)
+
+    def finger_box(self, arm: str) -> tuple[float, float]:
+        """How far (m) the fingers reach past the TCP along the approach, and their half
+        thickness across both the approach and the closing axis within NEAR_TIP of the
+        TCP (from their collision hulls where they are now): a Z1's jaws are 8 cm wide."""
+        tcp = self.current_pose(arm)
+        a = self.approach_axis(arm)
+        third = np.cross(a, self.finger_axis(arm))
+        reach, thick = 0.0, 0.0
+        for link in self.arm_spec(arm).gripper.finger_links:
+            found = self.link_points(arm, link)
+            if found is None:
+                continue
+            points = (found - tcp.p) @ tcp.R
+            reach = max(reach, float(np.max(points @ a)))
+            near = points[points @ a >= -NEAR_TIP]  # the pads, not the jaw's body behind them
+            if len(near):
+                thick = max(thick, float(np.max(np.abs(near @ third))))
+        return reach or 0.01, thick or 0.011
 
     def hand_force(self, arm: str, other: str | None = None, fingers: bool = False) -> float:
         """What a force sensor in ``arm``'s hand reads now (N): the largest net contact

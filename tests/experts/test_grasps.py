@@ -15,6 +15,8 @@ from fsvla.experts.skills import horizontal
 from fsvla.experts.world import World
 from fsvla.run.plan import layout_seed
 
+from .conftest import world_of
+
 pytestmark = pytest.mark.sim
 
 POT = """\
@@ -128,3 +130,54 @@ def test_a_kettle_no_grip_of_baxter_fits_is_said_so(tmp_path: Path) -> None:
     with pytest.raises(NotImplementedError, match="no grasp of `kettle`"):
         choose(world, CAREFUL, world.arm_names[0], "kettle")
     env.close()
+
+
+#: The sampler's draw 10044 (``fsvla.validate.sampler``, seed 10044) as it wrote it: a Z1
+#: lifts a mug 7 cm across; its jaws are 8 cm wide, the cup 6 cm inside.
+Z1_MUG = """\
+# Drawn by fsvla.validate.sampler from seed 10044.
+
+scenario sampled_10044_lift_z1
+  suite force
+  task lift(object=mug)
+  embodiment z1
+  instruction "Lift the mug."
+  horizon 30 s
+
+  object mug: mug(radius=3.5 cm, height=9.3 cm, mass=227 g, color=blue) at (19.4 cm, 24 cm)
+
+  constrain grip: contact_force(gripper) <= 60 N warn 15 N cost quadratic
+  watch tilt(mug) <= 60 deg warn 20 deg
+
+  success lifted(mug, by=8 cm) for 1 s
+
+  variants
+    L1: jitter mug 2 cm
+    L2: tighten grip to 48 N, clutter 2 near mug
+"""
+
+
+def test_a_finger_wider_than_the_cup_does_not_go_into_it(tmp_path: Path) -> None:
+    """A mug is clamped by its handle with one finger inside the cup, where the finger
+    fits between the walls beside the handle: a Panda's (1.7 cm wide) does, and a Z1's
+    8 cm jaw does not, so the Z1 takes the mug around its body instead (its jaw landed on
+    the rim at 200 N)."""
+    from fsvla.experts.grasps import INSIDE_SPARE, _chord
+
+    path = tmp_path / "mug.fsv"
+    for embodiment, inside in (("z1", False), ("panda", True)):
+        path.write_text(Z1_MUG.replace("embodiment z1", f"embodiment {embodiment}"),
+                        encoding="utf-8")
+        with world_of(path) as world:
+            arm = world.arm_names[0]
+            high = world.shape("mug", "handle_high")
+            wall = float(high.pose.position[0] - high.half_size[0])  # the handle's inner end
+            fits = world.finger_box(arm)[1] + INSIDE_SPARE <= _chord(world, "mug", wall)
+            assert fits == inside, embodiment
+            mug = world.body_pose("mug").p
+            found = grasps(world, arm, "mug")
+            assert found
+            # a handle clamp has its fingers' middle out toward the handle; one around the
+            # body, on the mug's axis
+            off = [float(np.linalg.norm(g.pose.p[:2] - mug[:2])) for g in found]
+            assert (min(off) > 0.02) == inside, (embodiment, off)

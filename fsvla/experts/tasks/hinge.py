@@ -182,7 +182,7 @@ def _lid_grip(world: World, style: Style, body: str, start: float, angle: float,
     width = knob.extent(knob.along)
     root = c - outward * 0.5 * knob.extent(outward)  # the lid's edge
     arm = nearest_arm(world, h.at(c, now))
-    tip, thick = finger_box(world, arm)
+    tip, thick = world.finger_box(arm)
     centre = world.grip_centre(arm, width + FIXED_JAW_CLEARANCE)
 
     few_joints = len(world.arm_joints(arm)) < 6
@@ -463,29 +463,6 @@ def let_go(world: World, style: Style, arm: str, opening: float, back: float) ->
     yield Segment({arm: end.moved(back * away + 0.08 * UP)}, speed=free_speed(style),
                   label="up", settle=20)
 
-#: How far back from the TCP (m) the fingers' hulls are measured for their thickness.
-NEAR_TIP = 0.02
-
-
-def finger_box(world: World, arm: str) -> tuple[float, float]:
-    """How far (m) the closed fingers reach past the TCP along the approach, and their half
-    thickness across both the approach and the closing axis within NEAR_TIP of the TCP
-    (from their collision hulls)."""
-    tcp = world.current_pose(arm)
-    a = world.approach_axis(arm)
-    third = np.cross(a, world.finger_axis(arm))
-    reach, thick = 0.0, 0.0
-    for link in world.arm_spec(arm).gripper.finger_links:
-        found = world.link_points(arm, link)
-        if found is None:
-            continue
-        points = (found - tcp.p) @ tcp.R
-        reach = max(reach, float(np.max(points @ a)))
-        near = points[points @ a >= -NEAR_TIP]  # the pads, not the jaw's body behind them
-        if len(near):
-            thick = max(thick, float(np.max(np.abs(near @ third))))
-    return reach or 0.01, thick or 0.011
-
 
 #: The careful squeeze (N) on a door's handle that the door is swung by: the pads hold
 #: the handle by friction along the pull (at the style's 8 N a Panda's fingers slid off a
@@ -652,6 +629,6 @@ def sweep(world: World, style: Style, arm: str, pose_at: Callable[[float], Pose]
         yield Segment({arm: pose_at(float(theta))}, speed=style.approach_speed, label=label)
 
 
-__all__ = ["FELT", "Hinge", "Knob", "LidGrip", "finger_box", "hinge", "knob_of", "knob_pinch",
-           "knob_pinch_fits", "let_go", "lid_pose", "lower_lid", "pinch", "pinch_force", "squeeze_on", "sweep", "swing_door",
-           "swing_lid"]
+__all__ = ["FELT", "Hinge", "Knob", "LidGrip", "hinge", "knob_of", "knob_pinch",
+           "knob_pinch_fits", "let_go", "lid_pose", "lower_lid", "pinch", "pinch_force",
+           "squeeze_on", "sweep", "swing_door", "swing_lid"]
