@@ -1,5 +1,5 @@
-"""Setting a held object into an open container (a pot, a bowl) without the hand touching
-it: a Panda hand is 21 cm long across its fingers, wider than a 19 cm pot's mouth, and
+"""Setting a held object into an open container (a pot, a bowl, a box whose lid stands
+open) without the hand touching it: a Panda hand is 21 cm long across its fingers, wider than a 19 cm pot's mouth, and
 coming down to put the object on the floor it lands on the rim (a -300 N knock on the
 gripper). The careful hand comes down only until some piece of the hand, or of the
 held object, would come within a margin of a piece of the container beneath it; the
@@ -113,20 +113,24 @@ def object_points(world: World, arm: str, obj: str) -> NDArray[np.float64]:
 
 def _pieces(world: World, body: str) -> list[tuple[NDArray, NDArray, NDArray]]:
     """The body's collision pieces as boxes in the world: (centre, rotation, half sizes);
-    a cylinder as the box around it."""
-    root = world.body_pose(body)
+    a cylinder as the box around it. An articulated body's, each where its link is now
+    (a lid standing open over its box)."""
     asset = world.asset(body)
-    shapes = getattr(asset, "collision", None) or [s for link in asset.links for s in link.collision]
+    links = getattr(asset, "links", None)
+    placed = ([(world.link_pose(body, link.name), link.collision) for link in links] if links
+              else [(world.body_pose(body), asset.collision)])
     pieces = []
-    for shape in shapes:
-        if getattr(shape, "half_size", None) is not None:
-            half = np.asarray(shape.half_size, dtype=np.float64)
-        elif getattr(shape, "radius", None) is not None and getattr(shape, "half_length", None) is not None:
-            half = np.array([shape.radius, shape.radius, shape.half_length], dtype=np.float64)
-        else:
-            continue
-        R = root.R @ quat_to_matrix(shape.pose.quaternion)
-        pieces.append((root.R @ np.asarray(shape.pose.position) + root.p, R, half))
+    for root, shapes in placed:
+        for shape in shapes:
+            if getattr(shape, "half_size", None) is not None:
+                half = np.asarray(shape.half_size, dtype=np.float64)
+            elif getattr(shape, "radius", None) is not None \
+                    and getattr(shape, "half_length", None) is not None:
+                half = np.array([shape.radius, shape.radius, shape.half_length], dtype=np.float64)
+            else:
+                continue
+            R = root.R @ quat_to_matrix(shape.pose.quaternion)
+            pieces.append((root.R @ np.asarray(shape.pose.position) + root.p, R, half))
     return pieces
 
 
@@ -157,8 +161,21 @@ def _lowest(points: NDArray[np.float64], pieces, beside: float, clear: float) ->
 
 
 def _cavity(world: World, target: str) -> tuple[NDArray[np.float64], float, float]:
-    """The cavity's axis point at its floor (world), its radius and its floor height."""
-    cavity = world.asset(target).cavity
+    """Where in ``target`` the held object is let go: the middle of its floor (world), how
+    far from it (m) the object's centre may be, and the floor's height. A cavity (a pot's):
+    its axis and radius. A box (a lidded box's ``bottom`` between its walls): the floor's
+    top, as far out as the nearer wall less the walls' thickness."""
+    cavity = getattr(world.asset(target), "cavity", None)
+    if cavity is None:
+        root = world.body_pose(target)
+        shapes = world.asset(target).links[0].collision
+        floor = next(shape for shape in shapes if shape.name == "bottom")
+        half = np.abs(np.asarray(floor.half_size, dtype=np.float64))
+        top = root.R @ (np.asarray(floor.pose.position) + np.array([0.0, 0.0, half[2]])) + root.p
+        wall = max((2.0 * float(np.min(np.abs(shape.half_size))) for shape in shapes
+                    if shape is not floor and getattr(shape, "half_size", None) is not None),
+                   default=0.0)
+        return top, max(0.0, float(min(half[0], half[1])) - wall), float(top[2])
     root = world.body_pose(target)
     centre = root.R @ np.asarray(cavity.pose.position) + root.p
     axis = root.R @ quat_to_matrix(cavity.pose.quaternion)[:, 2]

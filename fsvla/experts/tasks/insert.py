@@ -136,9 +136,10 @@ def _insert_into_cavity(world: World, style: Style, obj: str, target: str) -> Pl
 
 def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan:
     """A lidded container: lift the lid (careful: past vertical, where it stays open;
-    careless: only as far as asked less 0.2, and it falls shut), then pick the object and
-    set it on the container's floor, the hand's long axis along the container's longer
-    side (a Panda hand is 21 cm long)."""
+    careless: only as far as asked less 0.2, and it falls shut), then pick the object.
+    Careful: let it go over the floor as low as the hand stays clear of the walls and the
+    lid (:func:`~.cavity.place_in_cavity`); careless: from the height of the box's top,
+    the hand's long axis along the box's longer side (a Panda hand is 21 cm long)."""
     _part, joint = world.part(target)
     span = joint.upper - joint.lower
     need = required_fraction(world, target)
@@ -159,17 +160,22 @@ def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan
     # the arm that lifted the lid stands over the box the other carries to: out of its way
     yield from park_others(world, style, arm, (world.body_pose(obj).p, world.body_pose(target).p))
     yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
+    if style.honour_preconditions:
+        # careful: let go as low as the hand stays clear of the walls and of the lid
+        # standing open over them (a Panda hand is longer than most boxes are wide)
+        yield from place_in_cavity(world, style, arm, obj, target)
+        yield from retreat_home(world, style, arm)
+        return
+    # careless: over the middle of the floor, let go from the height of the box's top
     body = world.asset(target).links[0].name
     floor = world.shape(target, "bottom", link=body)
     root = world.body_pose(target)
     centre = root.R @ np.asarray(floor.pose.position) + root.p
-    bottom = np.array([centre[0], centre[1], centre[2] + float(floor.half_size[2])])
     lo, hi = world.bounds(target)
     longer = root.R[:, 0] if hi[0] - lo[0] >= hi[1] - lo[1] else root.R[:, 1]
     R = world.grasp_frame(arm, DOWN, longer)
-    if not style.honour_preconditions:  # careless: onto the top, let go from above
-        bottom[2] = float(hi[2])
-    yield from place(world, style, arm, obj, bottom, rotation=R, retreat=0.1)
+    yield from place(world, style, arm, obj, np.array([centre[0], centre[1], float(hi[2])]),
+                     rotation=R, retreat=0.1)
     yield from retreat_home(world, style, arm)
 
 
