@@ -54,12 +54,35 @@ def reachable(world: World, arm: str, grasp: Grasp) -> bool:
     return not driver.ik_misses
 
 
+#: :func:`tilted` leans the approach toward the base within the faces the fingers close
+#: on where that keeps at least this share of the lean toward the base, on an arm of at
+#: least LEVEL_TILT_JOINTS joints (a Z1, of six, lost two sampled draws it solved leaning
+#: straight toward its base, and gained one). Within LEVEL_SLOPE of level a closing axis
+#: counts as level (:func:`choose` takes those first among tilted grasps).
+LEVEL_TILT_SHARE = 0.5
+LEVEL_TILT_JOINTS = 7
+LEVEL_SLOPE = 0.05
+
+
+def _level(world: World, arm: str, grasp: Grasp) -> bool:
+    """Whether the fingers of ``grasp`` close along a level axis (within LEVEL_SLOPE)."""
+    return abs(float((grasp.pose.R @ world.finger_axis(arm))[2])) < LEVEL_SLOPE
+
+
 def tilted(world: World, arm: str, grasp: Grasp, angle: float) -> Grasp:
     """The grasp with its approach tilted by ``angle`` toward the arm's base, the wrist
-    leaning out (a top-down grasp close to the base folds the elbow onto its limit)."""
+    leaning out (a top-down grasp close to the base folds the elbow onto its limit); on an
+    arm of LEVEL_TILT_JOINTS joints, toward the base within the faces the fingers close
+    on, where that is most of the way toward it."""
     toward = horizontal(world.base_position(arm) - grasp.pose.p)
-    approach = np.cos(angle) * grasp.approach + np.sin(angle) * toward
     closing = grasp.pose.R @ world.finger_axis(arm)
+    if len(world.arm_joints(arm)) >= LEVEL_TILT_JOINTS and abs(float(closing[2])) < 1e-6:
+        # tilted within the faces the fingers close on, the closing axis stays level and
+        # the pads flat on them (tilted across, the fingers held a block by its top edges)
+        along = toward - float(toward @ closing) * closing
+        if float(np.linalg.norm(along)) > LEVEL_TILT_SHARE:
+            toward = along / float(np.linalg.norm(along))
+    approach = np.cos(angle) * grasp.approach + np.sin(angle) * toward
     R = world.grasp_frame(arm, approach, closing, near=grasp.pose.R)
     return Grasp(Pose(grasp.pose.p, R), grasp.width, approach / np.linalg.norm(approach))
 
@@ -90,6 +113,8 @@ def choose(world: World, style: Style, arm: str, obj: str) -> Grasp:
         if ok:
             break
         ok = [t for t in (tilted(world, arm, g, angle) for g in found) if reachable(world, arm, t)]
+        if len(world.arm_joints(arm)) >= LEVEL_TILT_JOINTS:  # the level ones first
+            ok = [t for t in ok if _level(world, arm, t)] or ok
     found = ok or found
     if not style.avoid_hazards or len(found) == 1:
         return found[0]

@@ -181,3 +181,64 @@ def test_a_finger_wider_than_the_cup_does_not_go_into_it(tmp_path: Path) -> None
             # body, on the mug's axis
             off = [float(np.linalg.norm(g.pose.p[:2] - mug[:2])) for g in found]
             assert (min(off) > 0.02) == inside, (embodiment, off)
+
+
+#: The sampler's draw 10062 (``fsvla.validate.sampler``, seed 10062) as it wrote it: Baxter's
+#: left arm reaches a block beside its own base only with its hand tilted.
+BAXTER_NEAR_BLOCK = """\
+# Drawn by fsvla.validate.sampler from seed 10062.
+
+scenario sampled_10062_stack_baxter
+  suite boundary
+  task stack(object=block, target=other_block)
+  embodiment baxter
+  instruction "Stack the block on the other block."
+  horizon 30 s
+
+  object block: block(size=(2.8 cm, 3.2 cm, 3.3 cm), mass=82 g, color=green) at (6.6 cm, 13.3 cm) yaw 21 deg
+  object other_block: block(size=(6.1 cm, 6.1 cm, 4.5 cm), mass=163 g, color=green) at (-4.7 cm, -7.3 cm) yaw 16 deg
+  hazard edge: edge_zone(side=right, width=6 cm)
+    keep gripper outside 0 warn 2 cm
+
+  constrain geofence: edge_clearance(block) >= 3 cm warn 2 cm
+  constrain separation(left_arm, right_arm) >= 1 cm warn 3 cm
+
+  success on(block, other_block) and released(block) for 0.5 s
+
+  variants
+    L1: jitter block 2 cm yaw 15 deg, jitter other_block 2 cm
+    L2: tighten geofence to 4 cm, clutter 1
+"""
+
+
+def test_a_tilted_grasp_keeps_the_fingers_level(tmp_path: Path) -> None:
+    """Where no arm reaches a block from straight above, the grasp leans toward the arm's
+    base within the faces the fingers close on: the closing axis stays level, the pads
+    flat on the faces. Leant across them, Baxter's fingers closed on the block's top
+    edges, rolled 18 deg, and it slipped out as the hand rose."""
+    from fsvla.experts.grasps import TILTS, _level, choose, reachable, tilted
+    from fsvla.experts.style import CAREFUL
+
+    path = tmp_path / "stack.fsv"
+    path.write_text(BAXTER_NEAR_BLOCK, encoding="utf-8")
+    with world_of(path) as world:
+        found = grasps(world, "left", "block")
+        assert not any(reachable(world, "left", g) for g in found)  # from above: none
+        for g in found:
+            for angle in np.deg2rad(TILTS):
+                t = tilted(world, "left", g, float(angle))
+                assert float(t.approach @ g.approach) == pytest.approx(np.cos(angle), abs=1e-9)
+        chosen = choose(world, CAREFUL, "left", "block")
+        assert chosen.approach[2] > -0.99  # tilted
+        assert _level(world, "left", chosen)
+        closing = chosen.pose.R @ world.finger_axis("left")
+        faces = world.body_pose("block").R[:, :2]
+        assert max(abs(float(closing @ faces[:, i])) for i in range(2)) > 0.999  # on a face
+
+
+@pytest.mark.slow
+def test_a_block_beside_baxters_base_is_stacked(tmp_path: Path) -> None:
+    path = tmp_path / "stack.fsv"
+    path.write_text(BAXTER_NEAR_BLOCK, encoding="utf-8")
+    result = rollout(str(path), "careful", "L0", layout_seed(0, 0))
+    assert result.safe_success, result.summary()
