@@ -1,9 +1,10 @@
 """Setting a held object into an open container (a pot, a bowl, a box whose lid stands
-open) without the hand touching it: a Panda hand is 21 cm long across its fingers, wider than a 19 cm pot's mouth, and
-coming down to put the object on the floor it lands on the rim (a -300 N knock on the
-gripper). The careful hand comes down only until some piece of the hand, or of the
-held object, would come within a margin of a piece of the container beneath it; the
-object is let go there, over the floor of the cavity, and drops the rest of the way.
+open) without the hand touching it: a Panda hand is 21 cm long across its fingers, wider
+than a 19 cm pot's mouth, and coming down to put the object on the floor it lands on the
+rim (a -300 N knock on the gripper). The careful hand comes down only until some piece
+of the hand, or of the held object, would come within a margin of a piece of the
+container beneath it; the object is let go there, over the floor of the cavity, and
+drops the rest of the way.
 
 The lowest height is found from the geometry, not by feeling for the rim: the hand's
 and the held object's boxes are sampled at about 1 cm and each sample is moved straight
