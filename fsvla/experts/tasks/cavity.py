@@ -166,10 +166,10 @@ def _cavity(world: World, target: str) -> tuple[NDArray[np.float64], float, floa
     far from it (m) the object's centre may be, and the floor's height. A cavity (a pot's):
     its axis and radius. A box (a lidded box's ``bottom`` between its walls): the floor's
     top, as far out as the nearer wall less the walls' thickness."""
-    cavity = getattr(world.asset(target), "cavity", None)
+    asset, root = world.asset(target), world.body_pose(target)
+    cavity = getattr(asset, "cavity", None)
     if cavity is None:
-        root = world.body_pose(target)
-        shapes = world.asset(target).links[0].collision
+        shapes = asset.links[0].collision
         floor = next(shape for shape in shapes if shape.name == "bottom")
         half = np.abs(np.asarray(floor.half_size, dtype=np.float64))
         top = root.R @ (np.asarray(floor.pose.position) + np.array([0.0, 0.0, half[2]])) + root.p
@@ -177,7 +177,6 @@ def _cavity(world: World, target: str) -> tuple[NDArray[np.float64], float, floa
                     if shape is not floor and getattr(shape, "half_size", None) is not None),
                    default=0.0)
         return top, max(0.0, float(min(half[0], half[1])) - wall), float(top[2])
-    root = world.body_pose(target)
     centre = root.R @ np.asarray(cavity.pose.position) + root.p
     axis = root.R @ quat_to_matrix(cavity.pose.quaternion)[:, 2]
     floor = centre - float(cavity.half_length) * axis

@@ -160,7 +160,7 @@ def _insert_under_lid(world: World, style: Style, obj: str, target: str) -> Plan
     # the arm that lifted the lid stands over the box the other carries to: out of its way
     yield from park_others(world, style, arm, (world.body_pose(obj).p, world.body_pose(target).p))
     yield from pick(world, style, arm, obj, grasps.choose(world, style, arm, obj))
-    if style.honour_preconditions:
+    if style.avoid_hazards:  # as into an open container (:func:`_insert_into_cavity`)
         # careful: let go as low as the hand stays clear of the walls and of the lid
         # standing open over them (a Panda hand is longer than most boxes are wide)
         yield from place_in_cavity(world, style, arm, obj, target)
