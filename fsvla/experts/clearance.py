@@ -16,6 +16,8 @@ Vertices of the convex collision hulls are a slight over-estimate of the true di
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -107,4 +109,18 @@ class ArmClearance:
         return nearest_box_distance(local, -half, half)
 
 
-__all__ = ["ArmClearance"]
+class LeastClearance:
+    """The smallest of several clearance measures (joints -> m), each with ``active``."""
+
+    def __init__(self, measures: Sequence[Callable[[NDArray[np.float64]], float]]) -> None:
+        self.measures = [m for m in measures if getattr(m, "active", True)]
+
+    @property
+    def active(self) -> bool:
+        return bool(self.measures)
+
+    def __call__(self, q: NDArray[np.float64]) -> float:
+        return min((m(q) for m in self.measures), default=float("inf"))
+
+
+__all__ = ["ArmClearance", "LeastClearance"]

@@ -491,13 +491,19 @@ def _straight_line_ok(segment: Segment, drivers: Mapping[str, ArmDriver], dt: fl
     for d in trial.values():
         d.ik_misses = 0
     straight = Segment(segment.targets, segment.speed, label=segment.label)
-    expand(straight, trial, dt, angular_speed)
+    steps = expand(straight, trial, dt, angular_speed)
     for name in segment.targets:
         d = trial[name]
         lo = d.kin.limits[:, 0] + LIMIT_MARGIN
         hi = d.kin.limits[:, 1] - LIMIT_MARGIN
         if d.ik_misses or np.any(d.q < lo) or np.any(d.q > hi):
             return False
+        if d.clearance is not None and steps:
+            # the arm's links must not cross a hard limit on the way that they are clear
+            # of at both ends (a seven-joint arm's elbow swings as the hand goes across)
+            ends = min(d.clearance(drivers[name].q), d.clearance(d.q))
+            if min(d.clearance(step.q[name]) for step in steps) < min(0.0, ends) - CROSS_SLACK:
+                return False
         branch = segment.branch_of.get(name)
         if branch is not None:  # the straight line on to the next pose must be followed,
             clear = d.line_clearance(d.q, d.pose, branch)  # the arm clear of the hazards
@@ -511,6 +517,9 @@ def _straight_line_ok(segment: Segment, drivers: Mapping[str, ArmDriver], dt: fl
     return True
 
 
+#: How far (m) past a hard limit a free-space straight line may take the arm's links
+#: (its clearance measure) before the move goes in joint space instead.
+CROSS_SLACK = 0.001
 #: How far (m) a joint-space move may take the TCP below the lower of its two ends, and
 #: how high above the table (z = 0) it must stay, before it goes by way of the arm's home:
 #: an arm changing IK branch may swing its hand down into the table on the straight line

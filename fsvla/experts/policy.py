@@ -28,11 +28,12 @@ import numpy as np
 from fsvla.compiler.pose import quat_to_matrix
 from fsvla.dsl.catalog import BIMANUAL_TASKS
 
-from .clearance import ArmClearance
+from .clearance import ArmClearance, LeastClearance
 from .motion import ArmDriver, Guard, Pose, Segment, Step, expand
 from .skills import carrying_arm, nearest_arm, park_others
 from .style import CAREFUL, CARELESS, STYLES, Style
 from .tasks import TASK_PLANS
+from .tasks.arm_gap import OtherArmClearance
 from .world import World
 
 #: Actions per chunk the experts return (the plan is re-read between segments anyway).
@@ -93,9 +94,7 @@ class ExpertPolicy:
             self._drivers[name] = ArmDriver(name, world.kinematics(name),
                                             world.current_pose(name), world.arm_joints(name),
                                             world.gripper_opening(name))
-            if self.style.avoid_hazards:  # its links too, not only the hand, kept clear
-                clearance = ArmClearance(world, name)
-                self._drivers[name].clearance = clearance if clearance.active else None
+            self._keep_clear(world, name)
         task_plan, roles = TASK_PLANS[task.name], dict(task.roles)
         if task.name in BIMANUAL_TASKS or len(world.arm_names) == 1:
             plan = task_plan.plan(world, self.style, roles)
@@ -112,11 +111,22 @@ class ExpertPolicy:
                 plan = task_plan.plan(world, self.style, roles)
             work = tuple(world.body_pose(body).p for body in task.roles.values())
             plan = chain(park_others(world, self.style, active, work), plan)
+            # the working arm keeps clear of the others where they stand (parked)
+            self._keep_clear(world, active, tuple(a for a in world.arm_names if a != active))
         self._plan = plan
         self._queue.clear()
         self._last = None
         self.log = []
         self.labels = []
+
+    def _keep_clear(self, world: World, arm: str, others: tuple[str, ...] = ()) -> None:
+        """Careful: the arm's IK chooses answers whose links, not only the hand, keep clear
+        of the hazards that watch them and of the ``others`` arms where they stand."""
+        if not self.style.avoid_hazards:
+            return
+        clearance = LeastClearance([ArmClearance(world, arm)] + [
+            OtherArmClearance(world, arm, other) for other in others])
+        self._drivers[arm].clearance = clearance if clearance.active else None
 
     def act(self, observation: dict[str, Any]) -> np.ndarray:
         if not self._drivers:

@@ -83,6 +83,7 @@ class World:
         self._open_width: dict[str, float] = {}
         self._closed_gap: dict[str, float] = {}
         self._rigid: dict[str, frozenset[int]] = {}
+        self._moved: dict[str, list[int]] = {}
         self._hand_depth: dict[str, float] = {}
 
     @classmethod
@@ -176,6 +177,21 @@ class World:
         if arm not in self._kinematics:
             self._kinematics[arm] = self.state.arm_model(arm)
         return self._kinematics[arm]
+
+    def moved_links(self, arm: str) -> list[int]:
+        """Indices (in the arm model's links) of the links the arm's own joints move or
+        turn (not a robot's torso, nor another arm's links)."""
+        if arm not in self._moved:
+            kin = self.kinematics(arm)
+            every = range(len(kin.link_names))
+            home = np.asarray(kin.spec.home, dtype=np.float64)
+            p0, r0 = kin.link_poses(home, every)
+            p1, r1 = kin.link_poses(home + 0.3, every)
+            r0, r1 = np.asarray(r0, dtype=np.float64), np.asarray(r1, dtype=np.float64)
+            turned = np.minimum(np.abs(r1 - r0).max(axis=1), np.abs(r1 + r0).max(axis=1)) > 1e-5
+            moved = (np.linalg.norm(np.asarray(p1) - np.asarray(p0), axis=1) > 1e-6) | turned
+            self._moved[arm] = [i for i in every if moved[i]]
+        return self._moved[arm]
 
     def hand_rigid_links(self, arm: str) -> frozenset[int]:
         """Indices (in the arm model's links) of the links whose pose relative to the TCP no

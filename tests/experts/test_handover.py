@@ -80,8 +80,9 @@ def test_arm_gap_measures_what_the_monitor_measures(tmp_path: Path, embodiment: 
     """ArmGap's margin on the arms' models, at the joints the arms are at, is the distance
     the monitor's own geometry gives between the two arms' links, less the limit and its
     warning band, to a millimetre, as the careful expert moves both arms through a
-    handover. (The monitor's per-step reading is exact only inside the band; its geometry
-    is asked for the exact distance here.)"""
+    handover; the same with the arms taken in the other order. (The monitor's per-step
+    reading is exact only inside the band; its geometry is asked for the exact distance
+    here.)"""
     from fsvla.env import make
     from fsvla.experts.policy import make_expert
     from fsvla.experts.tasks.arm_gap import ArmGap
@@ -93,6 +94,7 @@ def test_arm_gap_measures_what_the_monitor_measures(tmp_path: Path, embodiment: 
     expert.reset(None)
     world = World.of_env(env)
     gap = ArmGap(world, "left", "right")
+    turned = ArmGap(world, "right", "left")  # each arm's model numbers the links its own way
     layout = build_layout(env.monitor.spec, env.scene_spec)
     channels = [c for c in world.monitor.channels if c.metric == "separation"]
     compared = []
@@ -106,6 +108,8 @@ def test_arm_gap_measures_what_the_monitor_measures(tmp_path: Path, embodiment: 
                         for c in channels for subject in c.subjects)
             ours = gap.margin(world.arm_joints("left"), world.arm_joints("right"))
             assert ours == pytest.approx(exact, abs=1e-3), step
+            assert turned.margin(world.arm_joints("right"), world.arm_joints("left")) \
+                == pytest.approx(ours, abs=1e-6), step
             compared.append(ours)
         if terminated or truncated:
             break

@@ -26,9 +26,6 @@ from fsvla.monitor.state import robot_frame
 
 from ..world import World
 
-#: Joint offset (rad) that tells which arm's joints move a link.
-_PROBE = 0.3
-
 
 class ArmGap:
     """Smallest (distance − (limit + warning band)) between the links of arms ``a`` and
@@ -43,7 +40,8 @@ class ArmGap:
                     for arm in robot.arms}
         entities = {e.name: e for e in world.monitor.entities if isinstance(e, RobotEntity)}
         owner = {arm: self._moved_links(arm) for arm in self.arms}
-        self._checks: list[tuple[list[int], list[int], float]] = []
+        #: (links of a, links of b, hard limit, warning band) per separation channel
+        self._checks: list[tuple[list[int], list[int], float, float]] = []
         #: (arm, link index) -> the link's collision pieces: (FCL geometry, pose in the link)
         self._geometry: dict[tuple[str, int], list[tuple[fcl.CollisionGeometry,
                                                           NDArray[np.float64]]]] = {}
@@ -60,11 +58,22 @@ class ArmGap:
             b_second = self._of(second, b, robot_of, owner)
             a_second = self._of(second, a, robot_of, owner)
             b_first = self._of(first, b, robot_of, owner)
-            need = float(channel.limit + channel.soft_threshold)
-            if a_first and b_second:
-                self._checks.append((a_first, b_second, need))
+            limit, band = float(channel.limit), float(channel.soft_threshold)
+
+            def moves(links, arm: str) -> bool:
+                return any(link.robot == robot_of[arm] and link.link in owner[arm]
+                           for link in links)
+
+            # the side each arm plays: the group whose links it moves (a robot's static
+            # links, a mount on its torso, belong to either side)
+            if moves(first, a) and moves(second, b):
+                self._checks.append((a_first, b_second, limit, band))
+            elif moves(second, a) and moves(first, b):
+                self._checks.append((a_second, b_first, limit, band))
+            elif a_first and b_second:
+                self._checks.append((a_first, b_second, limit, band))
             elif a_second and b_first:
-                self._checks.append((a_second, b_first, need))
+                self._checks.append((a_second, b_first, limit, band))
         #: aligned(x, y, within=d) that a requirement asks of the two arms' reference
         #: points: (link index in a's model, link index in b's model, d)
         self._aligned: list[tuple[int, int, float]] = []
@@ -99,35 +108,35 @@ class ArmGap:
         return bool(self._aligned)
 
     @property
+    def separated(self) -> bool:
+        """Whether a separation limit watches the two arms."""
+        return bool(self._checks)
+
+    @property
     def watched(self) -> bool:
         """Whether a separation limit, or a required alignment, watches the two arms."""
         return bool(self._checks or self._aligned)
 
-    def _moved_links(self, arm: str) -> set[int]:
-        """Indices of the links the arm's own joints move."""
+    def _moved_links(self, arm: str) -> set[str]:
+        """Names of the links the arm's own joints move (and its hand's frame)."""
         kin = self.kin[arm]
-        every = range(len(kin.link_names))
-        home = np.asarray(kin.spec.home, dtype=np.float64)
-        p0, _ = kin.link_poses(home, every)
-        p1, _ = kin.link_poses(home + _PROBE, every)
-        moved = np.linalg.norm(np.asarray(p1) - np.asarray(p0), axis=1) > 1e-6
-        ee = list(kin.link_names).index(kin.spec.ee_link)
-        return {i for i in every if moved[i]} | {ee}
+        names = list(kin.link_names)
+        return {names[i] for i in self.world.moved_links(arm)} | {kin.spec.ee_link}
 
     def _of(self, links, arm: str, robot_of: dict[str, str],
-            owner: dict[str, set[int]]) -> list[int]:
+            owner: dict[str, set[str]]) -> list[int]:
         """The indices, in ``arm``'s model, of those of ``links`` that ``arm`` carries (its
         robot's links its joints move, and its static links that no other arm moves)."""
         names = list(self.kin[arm].link_names)
+        # by name: each arm's model numbers the robot's links its own way
         others = set().union(*(owner[o] for o in self.arms if o != arm
                                and robot_of[o] == robot_of[arm]))
         out = []
         for link in links:
             if link.robot != robot_of[arm] or link.link not in names:
                 continue
-            i = names.index(link.link)
-            if i in owner[arm] or i not in others:
-                out.append(i)
+            if link.link in owner[arm] or link.link not in others:
+                out.append(names.index(link.link))
         return sorted(set(out))
 
     def _objects(self, arm: str, q: NDArray[np.float64], links: list[int]) -> list:
@@ -144,11 +153,14 @@ class ArmGap:
                     np.ascontiguousarray(m[:3, :3]), np.ascontiguousarray(m[:3, 3]))))
         return out
 
-    def margin(self, qa: NDArray[np.float64], qb: NDArray[np.float64]) -> float:
+    def margin(self, qa: NDArray[np.float64], qb: NDArray[np.float64],
+               band: bool = True) -> float:
         """Smallest distance less (limit + warning band) over the channels, for arm ``a``
-        at joints ``qa`` and arm ``b`` at ``qb`` (m); +inf with no separation limit."""
+        at joints ``qa`` and arm ``b`` at ``qb`` (m); less the hard limit alone without
+        ``band``; +inf with no separation limit."""
         best = float("inf")
-        for ia, ib, need in self._checks:
+        for ia, ib, limit, warn in self._checks:
+            need = limit + warn if band else limit
             left, right = self._objects(self.arms[0], qa, ia), self._objects(self.arms[1], qb, ib)
             for x in left:
                 for y in right:
@@ -174,4 +186,24 @@ class ArmGap:
                    for s in np.linspace(0.0, 1.0, samples + 1))
 
 
-__all__ = ["ArmGap"]
+class OtherArmClearance:
+    """How far an arm's links, at joints ``q``, stay from another arm of the robot where
+    that one stands now, less the hard limit of the ``separation`` channels that watch the
+    two (m; +inf where none does): a clearance measure the IK chooses its answers by
+    (:class:`fsvla.experts.clearance.ArmClearance` is the one for hazards), so that an arm
+    working alone does not swing its elbow into the idle one."""
+
+    def __init__(self, world: World, arm: str, other: str) -> None:
+        self.world = world
+        self.other = other
+        self.gap = ArmGap(world, arm, other)
+
+    @property
+    def active(self) -> bool:
+        return self.gap.separated
+
+    def __call__(self, q: NDArray[np.float64]) -> float:
+        return self.gap.margin(q, self.world.arm_joints(self.other), band=False)
+
+
+__all__ = ["ArmGap", "OtherArmClearance"]
