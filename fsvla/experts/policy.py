@@ -94,8 +94,8 @@ class ExpertPolicy:
             self._drivers[name] = ArmDriver(name, world.kinematics(name),
                                             world.current_pose(name), world.arm_joints(name),
                                             world.gripper_opening(name))
-            self._keep_clear(world, name)
         task_plan, roles = TASK_PLANS[task.name], dict(task.roles)
+        active = None  # the arm that works alone while the others park
         if task.name in BIMANUAL_TASKS or len(world.arm_names) == 1:
             plan = task_plan.plan(world, self.style, roles)
         else:
@@ -111,8 +111,10 @@ class ExpertPolicy:
                 plan = task_plan.plan(world, self.style, roles)
             work = tuple(world.body_pose(body).p for body in task.roles.values())
             plan = chain(park_others(world, self.style, active, work), plan)
+        for name in world.arm_names:  # (the plans are generators: nothing has run yet)
             # the working arm keeps clear of the others where they stand (parked)
-            self._keep_clear(world, active, tuple(a for a in world.arm_names if a != active))
+            others = tuple(a for a in world.arm_names if a != name) if name == active else ()
+            self._keep_clear(world, name, others)
         self._plan = plan
         self._queue.clear()
         self._last = None

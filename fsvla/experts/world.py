@@ -36,6 +36,8 @@ PAD_DEPTH = 0.035
 NEAR_TIP = 0.02
 #: How much wider (m) than the gap its shut fingers leave an object must be to be squeezed.
 SQUEEZE_SPARE = 0.004
+#: Joint offset (rad) that tells which links an arm's joints move (:meth:`World.moved_links`).
+MOVE_PROBE = 0.3
 
 
 def box_distance(p: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]) -> float:
@@ -186,7 +188,7 @@ class World:
             every = range(len(kin.link_names))
             home = np.asarray(kin.spec.home, dtype=np.float64)
             p0, r0 = kin.link_poses(home, every)
-            p1, r1 = kin.link_poses(home + 0.3, every)
+            p1, r1 = kin.link_poses(home + MOVE_PROBE, every)
             r0, r1 = np.asarray(r0, dtype=np.float64), np.asarray(r1, dtype=np.float64)
             turned = np.minimum(np.abs(r1 - r0).max(axis=1), np.abs(r1 + r0).max(axis=1)) > 1e-5
             moved = (np.linalg.norm(np.asarray(p1) - np.asarray(p0), axis=1) > 1e-6) | turned

@@ -40,6 +40,10 @@ class ArmGap:
                     for arm in robot.arms}
         entities = {e.name: e for e in world.monitor.entities if isinstance(e, RobotEntity)}
         owner = {arm: self._moved_links(arm) for arm in self.arms}
+
+        def moves(links, arm: str) -> bool:
+            return any(link.robot == robot_of[arm] and link.link in owner[arm] for link in links)
+
         #: (links of a, links of b, hard limit, warning band) per separation channel
         self._checks: list[tuple[list[int], list[int], float, float]] = []
         #: (arm, link index) -> the link's collision pieces: (FCL geometry, pose in the link)
@@ -59,11 +63,6 @@ class ArmGap:
             a_second = self._of(second, a, robot_of, owner)
             b_first = self._of(first, b, robot_of, owner)
             limit, band = float(channel.limit), float(channel.soft_threshold)
-
-            def moves(links, arm: str) -> bool:
-                return any(link.robot == robot_of[arm] and link.link in owner[arm]
-                           for link in links)
-
             # the side each arm plays: the group whose links it moves (a robot's static
             # links, a mount on its torso, belong to either side)
             if moves(first, a) and moves(second, b):
