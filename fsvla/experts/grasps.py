@@ -15,9 +15,13 @@ from .motion import Pose
 from .skills import (
     DOWN,
     Grasp,
+    arm_clearance_along,
     attainable,
+    branch_for_path,
+    first_clear,
     fixed_jaw_shifted,
     hand_body,
+    hand_clearance,
     horizontal,
     top_down_grasp,
 )
@@ -371,19 +375,39 @@ HANDLE_PITCHES = (0.0, 15.0, 30.0, 40.0, 50.0, 60.0)
 
 
 def reach_handle(world: World, arm: str, obj: str, handle: str, back: float = 0.1,
-                 lift: float = 0.15) -> Grasp:
+                 lift: float = 0.15, avoid_hazards: bool = False) -> Grasp:
     """The flattest :func:`handle_grasp` whose whole path is followed on one IK branch
     inside the joint limits: down to ``back`` (m) out along the approach, in to the
-    handle, and up by ``lift`` (m); the horizontal one when no pitch is."""
-    from .skills import branch_for_path
-
-    for pitch in np.deg2rad(HANDLE_PITCHES):
-        grasp = handle_grasp(world, arm, obj, handle, float(pitch))
+    handle, and up by ``lift`` (m); the horizontal one when no pitch is. ``avoid_hazards``:
+    the flattest whose hand stays outside every keep-out along that path with
+    HAZARD_SPARE to spare and the arm's links outside every limit that watches them,
+    else the one that keeps farthest out (a hand coming in level from outside a pot's
+    handle lay with its body 2 cm inside a vase's keep-out beyond it; pitched down, its
+    body is over the handle)."""
+    def path(grasp: Grasp) -> tuple[Pose, ...]:
         pre = grasp.pose.moved(-back * grasp.approach)
-        path = (pre.moved(0.1 * UPV), pre, grasp.pose, grasp.pose.moved(lift * UPV))
-        if branch_for_path(world, arm, path) is not None:
-            return grasp
-    return handle_grasp(world, arm, obj, handle)
+        return pre.moved(0.1 * UPV), pre, grasp.pose, grasp.pose.moved(lift * UPV)
+
+    options = [handle_grasp(world, arm, obj, handle, float(p)) for p in np.deg2rad(HANDLE_PITCHES)]
+    branches: dict[int, NDArray[np.float64]] = {}  # option -> joints its path starts from
+
+    def followed(index: int) -> bool:
+        q = branch_for_path(world, arm, path(options[index]))
+        if q is not None:
+            branches[index] = q
+        return q is not None
+
+    def clearance(index: int) -> float:  # the hand's and the forearm's along the path
+        way = path(options[index])
+        return min(hand_clearance(world, arm, way, (obj,)),
+                   arm_clearance_along(world, arm, way, branches[index]))
+
+    indices = range(len(options))
+    if avoid_hazards:
+        chosen = first_clear(indices, followed, clearance)
+    else:
+        chosen = next((i for i in indices if followed(i)), None)
+    return options[chosen if chosen is not None else 0]
 
 
 def _side_handles(world: World, arm: str, obj: str) -> list[Grasp]:

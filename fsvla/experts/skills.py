@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from fsvla.compiler.pose import axis_angle_matrix, rotation_angle, slerp
 
+from .clearance import ArmClearance
 from .motion import ArmDriver, Guard, Pose, Segment
 from .style import Style
 from .world import World, box_distance
@@ -364,6 +365,32 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
         if best is not None:
             return best
     return best
+
+
+def arm_clearance_along(world: World, arm: str, path: tuple[Pose, ...],
+                        start: NDArray[np.float64]) -> float:
+    """The least :class:`~fsvla.experts.clearance.ArmClearance` of ``arm``'s links (m)
+    along ``path`` followed from joints ``start`` (for its first pose, on the branch
+    :func:`branch_for_path` finds), every few centimetres; inf where no limit watches
+    them. The hand's clearance is the TCP's path's (:func:`hand_clearance`); this is the
+    forearm's, which follows the branch (a Panda's, pitched down onto a pot's handle,
+    leaned on a vase beyond it)."""
+    measure = ArmClearance(world, arm)
+    if not measure.active:
+        return float("inf")
+    driver = ArmDriver(arm, world.kinematics(arm), path[0], start, 1.0)
+    least = measure(start)
+    for a, b in pairwise(path):
+        n = max(1, int(np.ceil(float(np.linalg.norm(b.p - a.p)) / CLEARANCE_STEP)))
+        for i in range(1, n + 1):
+            s = i / n
+            driver.q = driver.solve(Pose(a.p + s * (b.p - a.p), slerp(a.R, b.R, s)))
+            least = min(least, measure(driver.q))
+    return float(least)
+
+
+#: How far apart (m) :func:`arm_clearance_along` measures the arm along a path.
+CLEARANCE_STEP = 0.03
 
 
 #: How far (m) an idle arm moves its hand away from the working arm, at most, when a
@@ -869,6 +896,7 @@ __all__ = [
     "UP",
     "Grasp",
     "Plan",
+    "arm_clearance_along",
     "branch_for_path",
     "carried_rotation",
     "carried_turn",
