@@ -379,11 +379,11 @@ def reach_handle(world: World, arm: str, obj: str, handle: str, back: float = 0.
     """The flattest :func:`handle_grasp` whose whole path is followed on one IK branch
     inside the joint limits: down to ``back`` (m) out along the approach, in to the
     handle, and up by ``lift`` (m); the horizontal one when no pitch is. ``avoid_hazards``:
-    the flattest whose hand stays outside every keep-out along that path with
-    HAZARD_SPARE to spare and the arm's links outside every limit that watches them,
-    else the one that keeps farthest out (a hand coming in level from outside a pot's
-    handle lay with its body 2 cm inside a vase's keep-out beyond it; pitched down, its
-    body is over the handle)."""
+    the flattest whose hand stays HAZARD_SPARE outside every keep-out along that path,
+    and the arm's links as far outside every limit that watches them, else the one that
+    keeps farthest out (a hand coming in level from outside a pot's handle lay with its
+    body 2 cm inside a vase's keep-out beyond it; pitched down, its body is over the
+    handle)."""
     def path(grasp: Grasp) -> tuple[Pose, ...]:
         pre = grasp.pose.moved(-back * grasp.approach)
         return pre.moved(0.1 * UPV), pre, grasp.pose, grasp.pose.moved(lift * UPV)

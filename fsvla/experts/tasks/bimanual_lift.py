@@ -22,7 +22,8 @@ def plan_bimanual_lift(world: World, style: Style, roles: dict[str, str], by: fl
     if not style.honour_preconditions:
         yield from _lift_as_each_holds(world, style, obj, handles, by)
         return
-    chosen = {arm: grasps.reach_handle(world, arm, obj, h, lift=by, avoid_hazards=True)
+    chosen = {arm: grasps.reach_handle(world, arm, obj, h, lift=by,
+                                           avoid_hazards=style.avoid_hazards)
               for arm, h in handles.items()}
     for arm, g in chosen.items():  # one arm after the other to the pre-grasp, on the
         # IK branch from which the lines down and on to the handle are followed
