@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from fsvla.compiler.pose import quat_to_matrix
 
+from .clearance import ArmClearance
 from .motion import Pose
 from .skills import (
     DOWN,
@@ -390,6 +391,7 @@ def reach_handle(world: World, arm: str, obj: str, handle: str, back: float = 0.
 
     options = [handle_grasp(world, arm, obj, handle, float(p)) for p in np.deg2rad(HANDLE_PITCHES)]
     branches: dict[int, NDArray[np.float64]] = {}  # option -> joints its path starts from
+    measure = ArmClearance(world, arm) if avoid_hazards else None  # one for every option
 
     def followed(index: int) -> bool:
         q = branch_for_path(world, arm, path(options[index]))
@@ -400,7 +402,7 @@ def reach_handle(world: World, arm: str, obj: str, handle: str, back: float = 0.
     def clearance(index: int) -> float:  # the hand's and the forearm's along the path
         way = path(options[index])
         return min(hand_clearance(world, arm, way, (obj,)),
-                   arm_clearance_along(world, arm, way, branches[index]))
+                   arm_clearance_along(world, arm, way, branches[index], measure))
 
     indices = range(len(options))
     if avoid_hazards:

@@ -368,14 +368,17 @@ def branch_for_path(world: World, arm: str, path: tuple[Pose, ...]) -> NDArray[n
 
 
 def arm_clearance_along(world: World, arm: str, path: tuple[Pose, ...],
-                        start: NDArray[np.float64]) -> float:
+                        start: NDArray[np.float64],
+                        measure: ArmClearance | None = None) -> float:
     """The least :class:`~fsvla.experts.clearance.ArmClearance` of ``arm``'s links (m)
     along ``path`` followed from joints ``start`` (for its first pose, on the branch
     :func:`branch_for_path` finds), every few centimetres; inf where no limit watches
     them. The hand's clearance is the TCP's path's (:func:`hand_clearance`); this is the
     forearm's, which follows the branch (a Panda's, pitched down onto a pot's handle,
-    leaned on a vase beyond it)."""
-    measure = ArmClearance(world, arm)
+    leaned on a vase beyond it). ``measure``: the arm's, where the caller measures
+    several paths (built here otherwise)."""
+    if measure is None:
+        measure = ArmClearance(world, arm)
     if not measure.active:
         return float("inf")
     driver = ArmDriver(arm, world.kinematics(arm), path[0], start, 1.0)
