@@ -18,6 +18,7 @@ from ..skills import (
     free_speed,
     nearest_arm,
     opening_for,
+    reaches,
     transit,
 )
 from ..style import Style
@@ -188,11 +189,6 @@ def _handle_grip(world: World, arm: str, inward: np.ndarray, centre: np.ndarray,
         return ArmDriver(arm, world.kinematics(arm), world.current_pose(arm),
                          world.arm_joints(arm), 1.0)
 
-    def reached(tcp: Pose) -> bool:
-        probe = driver()
-        probe.solve_anywhere(tcp)
-        return probe.ik_misses == 0
-
     level: tuple[Pose, float] | None = None
     for pitch in HANDLE_PITCHES:
         a = np.deg2rad(pitch)
@@ -208,7 +204,7 @@ def _handle_grip(world: World, arm: str, inward: np.ndarray, centre: np.ndarray,
                 return tcp, width
         if level is None:  # the level hand: taken where reached, its pull followed or not
             level = (grips[0], width)
-            if any(reached(tcp) for tcp in grips):
+            if any(reaches(world, arm, tcp) for tcp in grips):
                 return level
     assert level is not None
     return level
